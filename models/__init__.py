@@ -1,0 +1,9 @@
+"""Single-mesh physics models, shipped as ``arlequin.models``.
+
+Models know nothing about Arlequin coupling: each assembled quantity takes an optional weight
+evaluated at quadrature points (the energy partition weight α, default 1).
+"""
+
+from .elastic import KINDS, IsotropicElastic, LinearElastic, scalar_element_for
+
+__all__ = ["KINDS", "IsotropicElastic", "LinearElastic", "scalar_element_for"]

@@ -1,0 +1,401 @@
+"""Small-strain linear elasticity on one mesh, with an optional weight at quadrature points.
+
+The model knows nothing about Arlequin: every assembled quantity takes an optional ``weight``
+(the energy partition weight α of the coupling core, default 1) evaluated at the quadrature
+points of the model's basis. Units are SI throughout: lengths in m, Young's modulus and stresses
+in Pa, density in kg/m³, forces in N.
+
+Kinematics (``kind``):
+
+``"1d"``
+    A bar along x with cross-section ``area`` (m²): energy ½∫ E A (u')² dx.
+``"plane_strain"``, ``"plane_stress"``
+    2D in (x, y), unit thickness (energies per metre of thickness).
+``"axisymmetric"``
+    Meridional coordinates (r, z) = (x[0], x[1]); integrals carry the full 2π r factor;
+    strains (ε_rr, ε_zz, ε_rz, ε_θθ = u_r / r).
+``"3d"``
+    Full 3D.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+from skfem import (
+    Basis,
+    BilinearForm,
+    ElementHex1,
+    ElementLineP1,
+    ElementQuad1,
+    ElementTetP1,
+    ElementTriP1,
+    ElementVector,
+    FacetBasis,
+    LinearForm,
+    Mesh,
+    MeshHex,
+    MeshLine,
+    MeshQuad,
+    MeshTet,
+    MeshTri,
+)
+from skfem.helpers import dot, grad
+
+__all__ = ["KINDS", "IsotropicElastic", "LinearElastic", "scalar_element_for"]
+
+KINDS = ("1d", "plane_strain", "plane_stress", "axisymmetric", "3d")
+
+_SCALAR_ELEMENT = {
+    MeshLine: ElementLineP1,
+    MeshTri: ElementTriP1,
+    MeshQuad: ElementQuad1,
+    MeshTet: ElementTetP1,
+    MeshHex: ElementHex1,
+}
+
+
+def scalar_element_for(mesh: Mesh):
+    """Return the first-order Lagrange element (P1 or Q1) matching ``mesh``'s cell type."""
+    for mesh_type, element in _SCALAR_ELEMENT.items():
+        if isinstance(mesh, mesh_type):
+            return element()
+    raise ValueError(
+        f"mesh type {type(mesh).__name__} is not supported; use a MeshLine, MeshTri, MeshQuad, "
+        "MeshTet or MeshHex (first order)"
+    )
+
+
+@dataclass(frozen=True)
+class IsotropicElastic:
+    """Isotropic linear elastic material.
+
+    Parameters
+    ----------
+    young : float
+        Young's modulus E (Pa), > 0.
+    poisson : float
+        Poisson's ratio ν, in (-1, 0.5).
+    density : float
+        Mass density ρ (kg/m³), ≥ 0.
+    """
+
+    young: float
+    poisson: float = 0.3
+    density: float = 1.0
+
+    def __post_init__(self) -> None:
+        if not np.isfinite(self.young) or self.young <= 0.0:
+            raise ValueError(f"Young's modulus must be positive and finite, got young={self.young}")
+        if not -1.0 < self.poisson < 0.5:
+            raise ValueError(f"Poisson's ratio must lie in (-1, 0.5), got poisson={self.poisson}")
+        if not np.isfinite(self.density) or self.density < 0.0:
+            raise ValueError(f"density must be non-negative and finite, got density={self.density}")
+
+    @property
+    def shear_modulus(self) -> float:
+        """Shear modulus μ = E / (2(1+ν)) (Pa)."""
+        return self.young / (2.0 * (1.0 + self.poisson))
+
+    @property
+    def lame_lambda(self) -> float:
+        """First Lamé parameter λ = Eν / ((1+ν)(1−2ν)) (Pa)."""
+        return self.young * self.poisson / ((1.0 + self.poisson) * (1.0 - 2.0 * self.poisson))
+
+    @property
+    def bulk_modulus(self) -> float:
+        """Bulk modulus K = E / (3(1−2ν)) (Pa)."""
+        return self.young / (3.0 * (1.0 - 2.0 * self.poisson))
+
+
+WeightLike = float | np.ndarray | Callable[[np.ndarray], np.ndarray] | None
+
+
+class LinearElastic:
+    """Linear elastic model on one first-order mesh (P1 simplices, Q1 quads/hexes).
+
+    Parameters
+    ----------
+    mesh : skfem.Mesh
+        MeshLine (``kind="1d"``), MeshTri/MeshQuad (2D kinds), MeshTet/MeshHex (``"3d"``).
+    material : IsotropicElastic
+    kind : str
+        One of :data:`KINDS`. Defaults to ``"1d"``, ``"plane_strain"`` or ``"3d"`` by dimension.
+    area : float
+        Cross-section area (m²) of a 1D bar; ignored otherwise.
+    intorder : int, optional
+        Quadrature order; default 3, exact for a linearly varying weight times the Q1 stiffness.
+
+    Notes
+    -----
+    Degrees of freedom are interleaved by node (scikit-fem's ``ElementVector`` ordering):
+    dof ``d * node + component``.
+    """
+
+    def __init__(
+        self,
+        mesh: Mesh,
+        material: IsotropicElastic,
+        kind: str | None = None,
+        area: float = 1.0,
+        intorder: int = 3,
+    ) -> None:
+        dim = mesh.dim()
+        if kind is None:
+            kind = {1: "1d", 2: "plane_strain", 3: "3d"}[dim]
+        if kind not in KINDS:
+            raise ValueError(f"kind must be one of {KINDS}, got kind={kind!r}")
+        expected_dim = {"1d": 1, "plane_strain": 2, "plane_stress": 2, "axisymmetric": 2, "3d": 3}
+        if expected_dim[kind] != dim:
+            raise ValueError(
+                f"kind={kind!r} needs a {expected_dim[kind]}D mesh, got a {dim}D "
+                f"{type(mesh).__name__}"
+            )
+        if area <= 0.0:
+            raise ValueError(f"cross-section area must be positive, got area={area}")
+        if kind == "axisymmetric" and np.min(mesh.p[0]) < -1e-12 * np.ptp(mesh.p[0]):
+            raise ValueError(
+                f"axisymmetric mesh must have r = x[0] >= 0, got min r = {np.min(mesh.p[0])}"
+            )
+        self.mesh = mesh
+        self.material = material
+        self.kind = kind
+        self.area = float(area)
+        self.intorder = int(intorder)
+        self.dim = dim
+        self.scalar_element = scalar_element_for(mesh)
+        self.element = ElementVector(self.scalar_element, dim=dim)
+        self.basis = Basis(mesh, self.element, intorder=self.intorder)
+
+    # ------------------------------------------------------------------ construction helpers
+    def with_mesh(self, mesh: Mesh) -> LinearElastic:
+        """Same material and kinematics on another mesh (used for overlap integration)."""
+        return LinearElastic(mesh, self.material, self.kind, self.area, self.intorder)
+
+    @property
+    def n_dofs(self) -> int:
+        """Number of displacement degrees of freedom."""
+        return int(self.basis.N)
+
+    @property
+    def n_components(self) -> int:
+        """Displacement components per node."""
+        return self.dim
+
+    def quadrature_points(self) -> np.ndarray:
+        """Physical quadrature points, shape (dim, n_elems, n_qp), in m."""
+        return np.asarray(self.basis.mapping.F(self.basis.X))
+
+    def nodal_dofs(self) -> np.ndarray:
+        """Dof indices per node, shape (dim, n_nodes)."""
+        return self.basis.nodal_dofs
+
+    def dofs_where(self, where: Callable[[np.ndarray], np.ndarray], components=None) -> np.ndarray:
+        """Dofs of the nodes ``x`` (shape (dim, n)) where ``where(x)`` is true.
+
+        Parameters
+        ----------
+        where : callable
+            Boolean predicate on node coordinates, shape (dim, n_nodes) -> (n_nodes,).
+        components : sequence of int, optional
+            Displacement components to keep (default: all).
+        """
+        nodes = np.nonzero(np.asarray(where(self.mesh.p), dtype=bool))[0]
+        comps = range(self.dim) if components is None else list(components)
+        return np.sort(self.basis.nodal_dofs[list(comps)][:, nodes].ravel())
+
+    # ------------------------------------------------------------------ weights
+    def weight_at_quadrature(self, weight: WeightLike, basis=None) -> np.ndarray:
+        """Evaluate ``weight`` at the quadrature points of ``basis`` (default: the cell basis).
+
+        Returns an array of shape (n_elems, n_qp). ``None`` means 1.
+        """
+        basis = self.basis if basis is None else basis
+        shape = basis.dx.shape
+        if weight is None:
+            return np.ones(shape)
+        if callable(weight):
+            values = np.asarray(weight(np.asarray(basis.mapping.F(basis.X))), dtype=float)
+            values = np.broadcast_to(values, shape)
+        else:
+            values = np.broadcast_to(np.asarray(weight, dtype=float), shape)
+        if not np.all(np.isfinite(values)):
+            raise ValueError("weight has non-finite values at quadrature points")
+        return np.ascontiguousarray(values)
+
+    def _measure(self, w) -> Any:
+        """Volume measure factor per unit reference measure: A (1D), 2πr (axi), 1 otherwise."""
+        if self.kind == "axisymmetric":
+            return 2.0 * np.pi * w.x[0]
+        if self.kind == "1d":
+            return self.area
+        return 1.0
+
+    # ------------------------------------------------------------------ constitutive law
+    def _lame(self) -> tuple[float, float]:
+        lam, mu = self.material.lame_lambda, self.material.shear_modulus
+        if self.kind == "plane_stress":
+            lam = 2.0 * lam * mu / (lam + 2.0 * mu)
+        if self.kind == "1d":
+            # uniaxial stress: σ = E ε
+            lam, mu = 0.0, 0.5 * self.material.young
+        return lam, mu
+
+    def _strain(self, u, w):
+        """Return (ε matrix (dim, dim, ...), hoop strain or 0)."""
+        g = grad(u)
+        eps = 0.5 * (g + np.swapaxes(g, 0, 1))
+        hoop = u[0] / w.x[0] if self.kind == "axisymmetric" else 0.0
+        return eps, hoop
+
+    def _energy_density_form(self, u, v, w):
+        lam, mu = self._lame()
+        eu, hu = self._strain(u, w)
+        ev, hv = self._strain(v, w)
+        tr_u = np.einsum("ii...", eu) + hu
+        tr_v = np.einsum("ii...", ev) + hv
+        return lam * tr_u * tr_v + 2.0 * mu * (np.einsum("ij...,ij...", eu, ev) + hu * hv)
+
+    # ------------------------------------------------------------------ assembled operators
+    def stiffness(self, weight: WeightLike = None) -> sp.csr_matrix:
+        """Weighted stiffness matrix ∫ α σ(u):ε(v), shape (n_dofs, n_dofs), N/m."""
+        alpha = self.weight_at_quadrature(weight)
+
+        @BilinearForm
+        def form(u, v, w):
+            return w.alpha * self._energy_density_form(u, v, w) * self._measure(w)
+
+        return form.assemble(self.basis, alpha=alpha).tocsr()
+
+    def mass(self, weight: WeightLike = None, lumped: bool = False):
+        """Weighted mass ∫ α ρ u·v (kg).
+
+        Returns a sparse matrix (n_dofs, n_dofs), or its row sums (n_dofs,) when ``lumped``.
+        """
+        alpha = self.weight_at_quadrature(weight)
+        rho = self.material.density
+
+        @BilinearForm
+        def form(u, v, w):
+            return w.alpha * rho * dot(u, v) * self._measure(w)
+
+        m = form.assemble(self.basis, alpha=alpha).tocsr()
+        if lumped:
+            return np.asarray(m.sum(axis=1)).ravel()
+        return m
+
+    def internal_force(self, u: np.ndarray, state=None, weight: WeightLike = None):
+        """Internal force K(α) u (N) and the (unchanged) state, for the integrators."""
+        return self.stiffness(weight) @ u, state
+
+    def strain_energy(self, u: np.ndarray, weight: WeightLike = None) -> float:
+        """Weighted strain energy ½ uᵀ K(α) u (J)."""
+        return 0.5 * float(u @ (self.stiffness(weight) @ u))
+
+    def body_force_vector(self, force, weight: WeightLike = None) -> np.ndarray:
+        """Load vector ∫ α f·v (N) for a body force density ``force`` (N/m³).
+
+        ``force`` is a constant vector (dim,) or a callable of x (dim, n_elems, n_qp) returning
+        (dim, n_elems, n_qp). For 1D bars the force is per unit volume (multiplied by the area).
+        """
+        alpha = self.weight_at_quadrature(weight)
+        fq = _vector_field(force, np.asarray(self.basis.mapping.F(self.basis.X)), self.dim)
+
+        @LinearForm
+        def form(v, w):
+            return w.alpha * dot(w.f, v) * self._measure(w)
+
+        return form.assemble(self.basis, alpha=alpha, f=fq)
+
+    def facet_basis(self, facets: np.ndarray) -> FacetBasis:
+        """scikit-fem facet basis on the given boundary facets."""
+        return FacetBasis(self.mesh, self.element, facets=np.asarray(facets), intorder=self.intorder)
+
+    def traction_vector(self, facets: np.ndarray, traction, weight: WeightLike = None) -> np.ndarray:
+        """Load vector ∫_Γ α t·v (N) for a traction ``t`` (Pa) on boundary ``facets``.
+
+        ``traction`` is a constant vector (dim,) or a callable of (x, n) with x and the outward
+        normal n of shape (dim, n_facets, n_qp), returning (dim, n_facets, n_qp).
+        """
+        facets = np.asarray(facets, dtype=np.int64)
+        if facets.size == 0:
+            return np.zeros(self.n_dofs)
+        fb = self.facet_basis(facets)
+        alpha = self.weight_at_quadrature(weight, basis=fb)
+        x = fb.global_coordinates().value
+        n = fb.normals.value
+        if callable(traction):
+            tq = np.asarray(traction(x, n), dtype=float)
+        else:
+            tq = _vector_field(traction, x, self.dim)
+        tq = np.broadcast_to(tq, x.shape)
+
+        @LinearForm
+        def form(v, w):
+            return w.alpha * dot(w.t, v) * self._measure(w)
+
+        return form.assemble(fb, alpha=alpha, t=np.ascontiguousarray(tq))
+
+    # ------------------------------------------------------------------ post-processing
+    def stress_at_quadrature(self, u: np.ndarray) -> np.ndarray:
+        """Cauchy stress at quadrature points, shape (3, 3, n_elems, n_qp) (Pa).
+
+        2D kinds fill the (x, y) block plus σ_zz (plane strain: λ tr ε; axisymmetric: σ_θθ);
+        1D fills σ_xx only.
+        """
+        lam, mu = self._lame()
+        uq = self.basis.interpolate(u)
+        g = uq.grad
+        d = self.dim
+        eps = 0.5 * (g + np.swapaxes(g, 0, 1))
+        out = np.zeros((3, 3) + g.shape[2:])
+        hoop = 0.0
+        if self.kind == "axisymmetric":
+            x = np.asarray(self.basis.mapping.F(self.basis.X))
+            hoop = uq.value[0] / x[0]
+        tr = np.einsum("ii...", eps) + hoop
+        out[:d, :d] = 2.0 * mu * eps
+        for i in range(d):
+            out[i, i] += lam * tr
+        if self.kind == "plane_strain":
+            out[2, 2] = lam * tr
+        elif self.kind == "axisymmetric":
+            out[2, 2] = lam * tr + 2.0 * mu * hoop
+        return out
+
+    def nodal_stress(self, u: np.ndarray) -> np.ndarray:
+        """Stress recovered at the nodes by lumped L2 projection, shape (3, 3, n_nodes) (Pa)."""
+        sq = self.stress_at_quadrature(u)
+        sbasis = self.basis.with_element(self.scalar_element)
+
+        @BilinearForm
+        def mass(u_, v_, w):
+            return u_ * v_
+
+        @LinearForm
+        def rhs(v_, w):
+            return w.s * v_
+
+        lumped = np.asarray(mass.assemble(sbasis).sum(axis=1)).ravel()
+        out = np.zeros((3, 3, self.mesh.nvertices))
+        for i in range(3):
+            for j in range(i, 3):
+                vals = rhs.assemble(sbasis, s=sq[i, j]) / lumped
+                out[i, j] = out[j, i] = vals[: self.mesh.nvertices]
+        return out
+
+
+def _vector_field(value, x: np.ndarray, dim: int) -> np.ndarray:
+    """Constant vector or callable of x -> array of shape x.shape (dim, ...)."""
+    if callable(value):
+        out = np.asarray(value(x), dtype=float)
+    else:
+        vec = np.asarray(value, dtype=float).reshape(-1)
+        if vec.size != dim:
+            raise ValueError(f"vector data must have {dim} components, got {vec.size}")
+        out = vec.reshape((dim,) + (1,) * (x.ndim - 1))
+    return np.ascontiguousarray(np.broadcast_to(out, x.shape))
