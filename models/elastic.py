@@ -26,49 +26,14 @@ from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
-from skfem import (
-    Basis,
-    BilinearForm,
-    ElementHex1,
-    ElementLineP1,
-    ElementQuad1,
-    ElementTetP1,
-    ElementTriP1,
-    ElementVector,
-    FacetBasis,
-    LinearForm,
-    Mesh,
-    MeshHex,
-    MeshLine,
-    MeshQuad,
-    MeshTet,
-    MeshTri,
-)
+from skfem import Basis, BilinearForm, ElementVector, FacetBasis, LinearForm, Mesh
 from skfem.helpers import dot, grad
+
+from arlequin.elements import scalar_element_for
 
 __all__ = ["KINDS", "IsotropicElastic", "LinearElastic", "scalar_element_for"]
 
 KINDS = ("1d", "plane_strain", "plane_stress", "axisymmetric", "3d")
-
-_SCALAR_ELEMENT = {
-    MeshLine: ElementLineP1,
-    MeshTri: ElementTriP1,
-    MeshQuad: ElementQuad1,
-    MeshTet: ElementTetP1,
-    MeshHex: ElementHex1,
-}
-
-
-def scalar_element_for(mesh: Mesh):
-    """Return the first-order Lagrange element (P1 or Q1) matching ``mesh``'s cell type."""
-    for mesh_type, element in _SCALAR_ELEMENT.items():
-        if isinstance(mesh, mesh_type):
-            return element()
-    raise ValueError(
-        f"mesh type {type(mesh).__name__} is not supported; use a MeshLine, MeshTri, MeshQuad, "
-        "MeshTet or MeshHex (first order)"
-    )
-
 
 @dataclass(frozen=True)
 class IsotropicElastic:
@@ -128,7 +93,8 @@ class LinearElastic:
     area : float
         Cross-section area (m²) of a 1D bar; ignored otherwise.
     intorder : int, optional
-        Quadrature order; default 3, exact for a linearly varying weight times the Q1 stiffness.
+        Quadrature order (polynomial degree integrated exactly). Default 3 (4 for hexahedra):
+        exact for a first-order weight times the stiffness of a linear field on P1/Q1 cells.
 
     Notes
     -----
@@ -142,7 +108,7 @@ class LinearElastic:
         material: IsotropicElastic,
         kind: str | None = None,
         area: float = 1.0,
-        intorder: int = 3,
+        intorder: int | None = None,
     ) -> None:
         dim = mesh.dim()
         if kind is None:
@@ -165,11 +131,17 @@ class LinearElastic:
         self.material = material
         self.kind = kind
         self.area = float(area)
+        if intorder is None:
+            intorder = 4 if mesh.t.shape[0] == 8 else 3
         self.intorder = int(intorder)
         self.dim = dim
         self.scalar_element = scalar_element_for(mesh)
         self.element = ElementVector(self.scalar_element, dim=dim)
         self.basis = Basis(mesh, self.element, intorder=self.intorder)
+
+    def scalar_basis(self) -> Basis:
+        """Scalar first-order basis with the model's quadrature (for weights at quadrature points)."""
+        return self.basis.with_element(self.scalar_element)
 
     # ------------------------------------------------------------------ construction helpers
     def with_mesh(self, mesh: Mesh) -> LinearElastic:
@@ -188,7 +160,7 @@ class LinearElastic:
 
     def quadrature_points(self) -> np.ndarray:
         """Physical quadrature points, shape (dim, n_elems, n_qp), in m."""
-        return np.asarray(self.basis.mapping.F(self.basis.X))
+        return np.asarray(self.basis.global_coordinates().value)
 
     def nodal_dofs(self) -> np.ndarray:
         """Dof indices per node, shape (dim, n_nodes)."""
@@ -219,7 +191,7 @@ class LinearElastic:
         if weight is None:
             return np.ones(shape)
         if callable(weight):
-            values = np.asarray(weight(np.asarray(basis.mapping.F(basis.X))), dtype=float)
+            values = np.asarray(weight(np.asarray(basis.global_coordinates().value)), dtype=float)
             values = np.broadcast_to(values, shape)
         else:
             values = np.broadcast_to(np.asarray(weight, dtype=float), shape)
@@ -303,7 +275,7 @@ class LinearElastic:
         (dim, n_elems, n_qp). For 1D bars the force is per unit volume (multiplied by the area).
         """
         alpha = self.weight_at_quadrature(weight)
-        fq = _vector_field(force, np.asarray(self.basis.mapping.F(self.basis.X)), self.dim)
+        fq = _vector_field(force, np.asarray(self.basis.global_coordinates().value), self.dim)
 
         @LinearForm
         def form(v, w):
@@ -355,7 +327,7 @@ class LinearElastic:
         out = np.zeros((3, 3) + g.shape[2:])
         hoop = 0.0
         if self.kind == "axisymmetric":
-            x = np.asarray(self.basis.mapping.F(self.basis.X))
+            x = np.asarray(self.basis.global_coordinates().value)
             hoop = uq.value[0] / x[0]
         tr = np.einsum("ii...", eps) + hoop
         out[:d, :d] = 2.0 * mu * eps

@@ -1,0 +1,165 @@
+"""Mediator space on the gluing zone and the L2 / H1 coupling matrices.
+
+The coupling operator between a mediator field λ and a displacement u on the gluing zone S_g is
+
+    L2:  c(λ, u) = ∫_Sg λ·u
+    H1:  c(λ, u) = ∫_Sg λ·u + ℓ² ε(λ):ε(u)
+
+(axisymmetric: measure 2π r dr dz, and ε is the meridional symmetric gradient in (r, z), so that a
+constant λ has zero strain). Both matrices
+
+    C_coarse[k, j] = c(ψ_k, φ_j^coarse),    C_fine[k, j] = c(ψ_k, φ_j^fine)
+
+are computed from one Gram matrix G on the gluing cells of the integration mesh I (see
+:mod:`arlequin.overlap`): C_model = Zᵀ G P_model, with P_model the (vector) transfer to I and Z the
+mediator functions written on I. One shared quadrature makes the two transfers exact adjoints.
+The mediator space is the coarse space restricted to S_g (default) or the fine one.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+from skfem import Basis, BilinearForm, ElementVector
+from skfem.helpers import dot, grad
+
+from .elements import scalar_element_for
+from .overlap import Overlap
+
+__all__ = ["CouplingMatrices", "MediatorError", "coupling_matrices", "gram_matrix"]
+
+
+class MediatorError(ValueError):
+    """The mediator space or the gluing zone is empty or ill-defined."""
+
+
+@dataclass(frozen=True)
+class CouplingMatrices:
+    """Coupling matrices of one patch.
+
+    Attributes
+    ----------
+    coarse : scipy.sparse.csr_matrix, shape (n_multipliers, n_coarse_dofs)
+    fine : scipy.sparse.csr_matrix, shape (n_multipliers, n_fine_dofs)
+    mediator_dofs : ndarray of int, shape (n_multipliers,)
+        Dofs of the mediator model (coarse or fine) that carry the mediator functions.
+    mediator : {"coarse", "fine"}
+    coupling : {"L2", "H1"}
+    length : float
+        H1 length ℓ (m); 0 for L2.
+    """
+
+    coarse: sp.csr_matrix
+    fine: sp.csr_matrix
+    mediator_dofs: np.ndarray
+    mediator: str
+    coupling: str
+    length: float
+
+    @property
+    def n_multipliers(self) -> int:
+        return int(self.coarse.shape[0])
+
+
+def gram_matrix(
+    overlap: Overlap,
+    gluing_cells: np.ndarray,
+    n_components: int,
+    coupling: str = "H1",
+    length: float = 0.0,
+    axisymmetric: bool = False,
+    intorder: int = 3,
+) -> sp.csr_matrix:
+    """Gram matrix of c(·,·) on the gluing cells of the integration mesh.
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix, shape (n_components n_I_nodes,) * 2
+    """
+    if coupling not in ("L2", "H1"):
+        raise ValueError(f"coupling must be 'L2' or 'H1', got {coupling!r}")
+    if coupling == "H1" and not length > 0.0:
+        raise ValueError(f"H1 coupling needs a positive length, got length={length}")
+    mesh = overlap.integration_mesh
+    gluing_cells = np.asarray(gluing_cells, dtype=np.int64)
+    if gluing_cells.size == 0:
+        raise MediatorError("the gluing zone is empty: no integration cell lies in it")
+    element = ElementVector(scalar_element_for(mesh), dim=n_components)
+    basis = Basis(mesh, element, elements=gluing_cells, intorder=intorder)
+    ell2 = float(length) ** 2 if coupling == "H1" else 0.0
+
+    def strain(u):
+        g = grad(u)
+        return 0.5 * (g + np.swapaxes(g, 0, 1))
+
+    @BilinearForm
+    def form(u, v, w):
+        measure = 2.0 * np.pi * w.x[0] if axisymmetric else 1.0
+        value = dot(u, v)
+        if ell2:
+            value = value + ell2 * np.einsum("ij...,ij...", strain(u), strain(v))
+        return value * measure
+
+    return form.assemble(basis).tocsr()
+
+
+def coupling_matrices(
+    overlap: Overlap,
+    gluing_cells: np.ndarray,
+    n_components: int,
+    coupling: str = "H1",
+    length: float | None = None,
+    mediator: str = "coarse",
+    axisymmetric: bool = False,
+    intorder: int = 3,
+) -> CouplingMatrices:
+    """Assemble C_coarse and C_fine on the gluing cells of an overlap.
+
+    Parameters
+    ----------
+    overlap : Overlap
+    gluing_cells : ndarray of int
+        Cells of the integration mesh that form the gluing zone S_g.
+    n_components : int
+        Displacement components per node.
+    coupling : {"L2", "H1"}
+    length : float, optional
+        H1 length ℓ (m), required for H1.
+    mediator : {"coarse", "fine"}
+        Which model's space, restricted to S_g, carries the multipliers.
+    axisymmetric : bool
+        Use the 2π r measure (meridional coordinates (r, z)).
+
+    Raises
+    ------
+    MediatorError
+        Empty gluing zone or a mediator space with no support on it.
+    """
+    if mediator not in ("coarse", "fine"):
+        raise ValueError(f"mediator must be 'coarse' or 'fine', got {mediator!r}")
+    gram = gram_matrix(
+        overlap, gluing_cells, n_components, coupling, length or 0.0, axisymmetric, intorder
+    )
+    pc = overlap.vector_transfer("coarse", n_components)
+    pf = overlap.vector_transfer("fine", n_components)
+    pm = pc if mediator == "coarse" else pf
+    # mediator functions = those of the chosen model whose support meets S_g with positive measure
+    mesh = overlap.integration_mesh
+    gluing_nodes = np.unique(mesh.t[:, np.asarray(gluing_cells)])
+    rows = (gluing_nodes[:, None] * n_components + np.arange(n_components)).ravel()
+    support = np.asarray(abs(pm[rows]).max(axis=0).todense()).ravel() > 1e-12
+    mediator_dofs = np.nonzero(support)[0]
+    if mediator_dofs.size == 0:
+        raise MediatorError(f"the {mediator} mediator space has no support on the gluing zone")
+    z = pm[:, mediator_dofs]
+    zt_g = (z.T @ gram).tocsr()
+    return CouplingMatrices(
+        coarse=(zt_g @ pc).tocsr(),
+        fine=(zt_g @ pf).tocsr(),
+        mediator_dofs=mediator_dofs,
+        mediator=mediator,
+        coupling=coupling,
+        length=float(length or 0.0) if coupling == "H1" else 0.0,
+    )

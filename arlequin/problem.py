@@ -1,0 +1,525 @@
+"""An Arlequin problem: a coarse model, refined patches, weights, mediators, loads and supports.
+
+Usage
+-----
+>>> problem = ArlequinProblem(coarse_model, [Patch(fine_model, gluing_width=0.1)])
+>>> problem.add_dirichlet("coarse", where=lambda x: x[0] < 1e-12)
+>>> problem.add_traction([1e6, 0.0], where=lambda x: x[0] > 1 - 1e-12)
+>>> result = arlequin.solve_static(problem)
+
+Models are any objects following :class:`arlequin.system.Model` (``arlequin.models`` provides
+them); the core never imports them. All quantities are SI.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+from .coupling import CouplingMatrices, MediatorError, coupling_matrices
+from .geometry import distance_to_facets, facet_coordinates
+from .locate import cell_centroids, cell_sizes, locate_points
+from .overlap import Overlap, OverlapError, build_overlap
+from .system import Block, BlockTerm, CoupledSystem, LinearConstraint
+from .weights import PartitionWeights, check_partition_of_unity, make_weights
+
+__all__ = ["ArlequinProblem", "Patch", "PatchCoupling"]
+
+logger = logging.getLogger(__name__)
+
+
+@dataclass
+class Patch:
+    """A refined model superposed on part of the coarse model.
+
+    Parameters
+    ----------
+    model : Model
+        The patch's model on its own (fine) mesh.
+    gluing_width : float, optional
+        Width (m) of the gluing band inside the patch along its interior boundary (the part of
+        its boundary inside the coarse domain). Snapped outwards to the fine cells whose centroid
+        lies within it, so the band's inner edge is made of fine-cell faces.
+    weights : {"ramp", "constant"} or PartitionWeights
+    epsilon : float
+        Floor of α_coarse inside the patch beyond the band.
+    coupling : {"L2", "H1"}
+    mediator : {"coarse", "fine"}
+    length : float, optional
+        H1 coupling length ℓ (m); default: the (snapped) gluing width.
+    gluing_region : callable, optional
+        Instead of a band: fine cells whose centroid x (dim, n) satisfies ``gluing_region(x)``.
+    overlap_method : {"auto", "nested", "intersection"}
+        See :func:`arlequin.overlap.build_overlap`.
+    boundary_tol : float
+        Fraction of the local coarse cell size within which patch points outside the coarse mesh
+        are accepted (faceted curved boundaries) and patch facets count as lying on the coarse
+        boundary.
+    name : str, optional
+        Block name; default ``"patch<i>"``.
+    """
+
+    model: Any
+    gluing_width: float | None = None
+    weights: str | PartitionWeights = "ramp"
+    epsilon: float = 1e-3
+    coupling: str = "H1"
+    mediator: str = "coarse"
+    length: float | None = None
+    gluing_region: Callable[[np.ndarray], np.ndarray] | None = None
+    overlap_method: str = "auto"
+    boundary_tol: float = 0.05
+    name: str | None = None
+
+    def __post_init__(self) -> None:
+        if self.gluing_width is None and self.gluing_region is None:
+            raise ValueError("a patch needs a gluing_width (m) or a gluing_region")
+        if self.gluing_width is not None and not self.gluing_width > 0.0:
+            raise ValueError(f"gluing_width must be positive, got gluing_width={self.gluing_width}")
+        if self.coupling not in ("L2", "H1"):
+            raise ValueError(f"coupling must be 'L2' or 'H1', got {self.coupling!r}")
+        if self.mediator not in ("coarse", "fine"):
+            raise ValueError(f"mediator must be 'coarse' or 'fine', got {self.mediator!r}")
+        if self.length is not None and not self.length > 0.0:
+            raise ValueError(f"H1 length must be positive, got length={self.length}")
+        self.weights = make_weights(self.weights, self.epsilon)
+
+
+class PatchCoupling:
+    """Everything computed for one patch: overlap, weights, gluing zone, coupling matrices.
+
+    Built by :class:`ArlequinProblem`; exposed for post-processing and tests.
+    """
+
+    def __init__(self, coarse_model: Any, patch: Patch, name: str) -> None:
+        self.patch = patch
+        self.name = name
+        self.coarse_model = coarse_model
+        self.fine_model = patch.model
+        self.weights: PartitionWeights = patch.weights  # type: ignore[assignment]
+        cmesh, fmesh = coarse_model.mesh, patch.model.mesh
+        self.overlap: Overlap = build_overlap(cmesh, fmesh, patch.overlap_method, patch.boundary_tol)
+        self.n_components = int(coarse_model.n_components)
+        if int(patch.model.n_components) != self.n_components:
+            raise ValueError(
+                f"mismatched dimensions: coarse model has {self.n_components} displacement "
+                f"components, patch {name} has {patch.model.n_components}"
+            )
+        if getattr(coarse_model, "kind", None) != getattr(patch.model, "kind", None):
+            raise ValueError(
+                f"mismatched kinematics: coarse kind={getattr(coarse_model, 'kind', None)!r}, "
+                f"patch kind={getattr(patch.model, 'kind', None)!r}"
+            )
+        self.axisymmetric = getattr(coarse_model, "kind", None) == "axisymmetric"
+        self._classify_boundary()
+        self._gluing_zone()
+        self.integration_model = coarse_model.with_mesh(self.overlap.integration_mesh)
+        self._evaluate_weights()
+        length = patch.length if patch.length is not None else self.gluing_width
+        self.coupling: CouplingMatrices = coupling_matrices(
+            self.overlap,
+            self.gluing_cells,
+            self.n_components,
+            patch.coupling,
+            length,
+            patch.mediator,
+            self.axisymmetric,
+        )
+
+    # ------------------------------------------------------------------ geometry
+    def _coarse_boundary_facets(self) -> np.ndarray:
+        return facet_coordinates(self.coarse_model.mesh)
+
+    def on_coarse_boundary(self, x: np.ndarray) -> np.ndarray:
+        """Whether points x (dim, n) lie on the coarse mesh's boundary (within boundary_tol h)."""
+        cmesh = self.coarse_model.mesh
+        dist = distance_to_facets(x, self._coarse_facets)
+        loc = locate_points(cmesh, x, tol=max(self.patch.boundary_tol, 1e-6))
+        h = np.where(loc.cells >= 0, self._coarse_h[np.maximum(loc.cells, 0)], self._coarse_h.max())
+        return dist <= self.patch.boundary_tol * h
+
+    def _classify_boundary(self) -> None:
+        fmesh = self.fine_model.mesh
+        self._coarse_facets = self._coarse_boundary_facets()
+        self._coarse_h = cell_sizes(self.coarse_model.mesh)
+        bfacets = fmesh.boundary_facets()
+        mid = fmesh.p[:, fmesh.facets[:, bfacets]].mean(axis=1)
+        on = self.on_coarse_boundary(mid)
+        self.outer_facets = bfacets[on]
+        self.interior_facets = bfacets[~on]
+        self._interior_coords = facet_coordinates(fmesh, self.interior_facets)
+
+    def distance(self, x: np.ndarray) -> np.ndarray:
+        """Distance (m) from points x (dim, n) to the patch's interior boundary, shape (n,)."""
+        shape = x.shape[1:]
+        return distance_to_facets(x.reshape(x.shape[0], -1), self._interior_coords).reshape(shape)
+
+    def _gluing_zone(self) -> None:
+        fmesh = self.fine_model.mesh
+        centroids = cell_centroids(fmesh)
+        if self.patch.gluing_region is not None:
+            fine_gluing = np.asarray(self.patch.gluing_region(centroids), dtype=bool)
+            d_nodes = self.distance(fmesh.p) if self.interior_facets.size else np.zeros(fmesh.nvertices)
+            width = float(d_nodes[fmesh.t[:, fine_gluing]].max()) if fine_gluing.any() else 0.0
+        else:
+            if self.interior_facets.size == 0:
+                raise MediatorError(
+                    f"empty gluing zone for {self.name}: the patch boundary has no part inside the "
+                    "coarse domain (give a gluing_region instead of a gluing_width)"
+                )
+            w = float(self.patch.gluing_width)
+            dc = self.distance(centroids)
+            fine_gluing = dc < w
+            d_nodes = self.distance(fmesh.p)
+            # snap: the band's inner edge goes through the outer vertices of the selected cells
+            width = float(d_nodes[fmesh.t[:, fine_gluing]].max()) if fine_gluing.any() else 0.0
+            if fine_gluing.any() and abs(width - w) > 1e-9 * w:
+                logger.info("%s: gluing width %.6g m snapped to %.6g m", self.name, w, width)
+        if not fine_gluing.any() or width <= 0.0:
+            raise MediatorError(
+                f"empty gluing zone for {self.name}: no patch cell lies within the gluing band "
+                f"(gluing_width={self.patch.gluing_width})"
+            )
+        self.gluing_width = width
+        self.fine_gluing_cells = np.nonzero(fine_gluing)[0]
+        self.gluing_cells = np.nonzero(fine_gluing[self.overlap.fine_cells])[0]
+        if self.gluing_cells.size == 0:
+            raise MediatorError(f"empty gluing zone for {self.name}: it does not overlap the coarse mesh")
+
+    # ------------------------------------------------------------------ weights
+    def _weights_at(self, basis, which: str) -> np.ndarray:
+        """α_which at the quadrature points of a scalar cell basis, shape (n_elems, n_qp)."""
+        mesh = basis.mesh
+        fn = self.weights.alpha_coarse if which == "coarse" else self.weights.alpha_fine
+        mode = self.weights.mode
+        if mode == "nodal":
+            nodal = fn(mesh.p, self.distance(mesh.p), self.gluing_width)
+            return np.asarray(basis.interpolate(np.asarray(nodal, dtype=float)).value)
+        if mode == "cell":
+            c = cell_centroids(mesh)
+            per_cell = np.asarray(fn(c, self.distance(c), self.gluing_width), dtype=float)
+            return np.repeat(per_cell[:, None], basis.dx.shape[1], axis=1)
+        x = np.asarray(basis.global_coordinates().value)
+        return np.broadcast_to(fn(x, self.distance(x), self.gluing_width), basis.dx.shape).copy()
+
+    def weight_function(self, which: str) -> Callable[[np.ndarray], np.ndarray]:
+        """Pointwise α_which(x) for x (dim, ...) (used on boundary facets)."""
+        fn = self.weights.alpha_coarse if which == "coarse" else self.weights.alpha_fine
+        return lambda x: fn(x, self.distance(x), self.gluing_width)
+
+    def _evaluate_weights(self) -> None:
+        ibasis = self.integration_model.scalar_basis()
+        alpha_c = self._weights_at(ibasis, "coarse")
+        alpha_f = self._weights_at(ibasis, "fine")
+        check_partition_of_unity(alpha_c, alpha_f, np.asarray(ibasis.mapping.F(ibasis.X)))
+        self.alpha_fine_overlap = alpha_f
+        self.alpha_coarse_overlap = alpha_c
+        self.alpha_fine = self._weights_at(self.fine_model.scalar_basis(), "fine")
+
+    # ------------------------------------------------------------------ operators
+    @cached_property
+    def coarse_transfer(self) -> sp.csr_matrix:
+        """Vector transfer coarse dofs -> integration-mesh dofs."""
+        return self.overlap.vector_transfer("coarse", self.n_components)
+
+    @cached_property
+    def covered_coarse_cells(self) -> np.ndarray:
+        """Coarse cells entirely covered by the integration mesh (boolean, (n_coarse_cells,)).
+
+        On these the coarse model's terms are integrated on the overlap cells only, with weight
+        α_coarse; on partly covered cells (non-nested overlaps) the overlap part −α_fine is
+        subtracted from the full-cell integral. Never subtracting on fully covered cells keeps
+        the weighted coarse operators positive even where Gauss quadrature is not exact
+        (distorted quadrilaterals) and α_coarse = ε is small.
+        """
+        cmesh = self.coarse_model.mesh
+        imodel = self.integration_model
+        i_measure = np.bincount(
+            self.overlap.coarse_cells,
+            weights=imodel.scalar_basis().dx.sum(axis=1),
+            minlength=cmesh.nelements,
+        )
+        c_measure = self.coarse_model.scalar_basis().dx.sum(axis=1)
+        return np.abs(i_measure - c_measure) <= 1e-9 * c_measure
+
+    def coarse_overlap_term(self) -> BlockTerm:
+        """The coarse model's contribution inside the overlap, integrated on the overlap cells.
+
+        Weight α_coarse on the overlap cells of fully covered coarse cells, −α_fine on those of
+        partly covered ones (see :attr:`covered_coarse_cells`).
+        """
+        covered = self.covered_coarse_cells[self.overlap.coarse_cells]
+        weight = np.where(covered[:, None], self.alpha_coarse_overlap, -self.alpha_fine_overlap)
+        return BlockTerm(self.integration_model, weight, self.coarse_transfer, 1.0)
+
+    def fine_term(self) -> BlockTerm:
+        return BlockTerm(self.fine_model, self.alpha_fine)
+
+    def integration_boundary_facets(self) -> np.ndarray:
+        """Boundary facets of the integration mesh that lie on the coarse mesh's boundary."""
+        imesh = self.overlap.integration_mesh
+        bf = imesh.boundary_facets()
+        mid = imesh.p[:, imesh.facets[:, bf]].mean(axis=1)
+        return bf[self.on_coarse_boundary(mid)]
+
+
+def _facet_midpoints(mesh, facets: np.ndarray) -> np.ndarray:
+    return mesh.p[:, mesh.facets[:, facets]].mean(axis=1)
+
+
+@dataclass
+class _Load:
+    kind: str  # "body" or "traction"
+    value: Any
+    where: Callable[[np.ndarray], np.ndarray] | None
+    amplitude: Callable[[float], float] | None
+    blocks: Sequence[str] | None
+
+
+@dataclass
+class _Dirichlet:
+    block: str
+    where: Callable[[np.ndarray], np.ndarray]
+    components: Sequence[int] | None
+    value: Any
+    amplitude: Callable[[float], float] | None
+    level: str
+
+
+@dataclass
+class ArlequinProblem:
+    """A coarse model plus refined patches, coupled by Lagrange-multiplier mediators.
+
+    Parameters
+    ----------
+    coarse : Model
+        The model of the whole structure.
+    patches : sequence of Patch
+        Non-overlapping refined patches.
+    """
+
+    coarse: Any
+    patches: Sequence[Patch] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        self.patches = list(self.patches)
+        self._loads: list[_Load] = []
+        self._dirichlet: list[_Dirichlet] = []
+        self._couplings: list[PatchCoupling] | None = None
+        self._names = ["coarse"] + [p.name or f"patch{i}" for i, p in enumerate(self.patches)]
+        if len(set(self._names)) != len(self._names):
+            raise ValueError(f"block names must be unique, got {self._names}")
+        self._check_patches_disjoint()
+
+    # ------------------------------------------------------------------ set-up
+    @property
+    def block_names(self) -> list[str]:
+        return list(self._names)
+
+    def _check_patches_disjoint(self) -> None:
+        for i, a in enumerate(self.patches):
+            for j in range(i + 1, len(self.patches)):
+                b = self.patches[j]
+                ma, mb = a.model.mesh, b.model.mesh
+                if ma.dim() != mb.dim():
+                    raise ValueError(
+                        f"mismatched dimensions: patch {i} is {ma.dim()}D, patch {j} is {mb.dim()}D"
+                    )
+                lo = np.maximum(ma.p.min(axis=1), mb.p.min(axis=1))
+                hi = np.minimum(ma.p.max(axis=1), mb.p.max(axis=1))
+                if np.any(lo >= hi):
+                    continue
+                loc = locate_points(ma, cell_centroids(mb), tol=0.0)
+                loc2 = locate_points(mb, cell_centroids(ma), tol=0.0)
+                if loc.inside.any() or loc2.inside.any():
+                    raise OverlapError(
+                        f"patches {self._names[i + 1]} and {self._names[j + 1]} overlap; "
+                        "overlapping patches are not supported (merge them into one patch)"
+                    )
+
+    @property
+    def couplings(self) -> list[PatchCoupling]:
+        """Per-patch overlap, weights and coupling matrices (built on first use)."""
+        if self._couplings is None:
+            self._couplings = [
+                PatchCoupling(self.coarse, p, self._names[i + 1]) for i, p in enumerate(self.patches)
+            ]
+        return self._couplings
+
+    def model(self, block: str) -> Any:
+        """The model of a block (``"coarse"`` or a patch name)."""
+        if block not in self._names:
+            raise ValueError(f"unknown block {block!r}; blocks are {self._names}")
+        i = self._names.index(block)
+        return self.coarse if i == 0 else self.patches[i - 1].model
+
+    def add_dirichlet(
+        self,
+        block: str,
+        where: Callable[[np.ndarray], np.ndarray],
+        components: Sequence[int] | None = None,
+        value: float | np.ndarray | Callable[[np.ndarray], np.ndarray] = 0.0,
+        amplitude: Callable[[float], float] | None = None,
+        level: str = "displacement",
+    ) -> None:
+        """Prescribe displacements (m) (``level="velocity"``: velocities, m/s) on a block's nodes.
+
+        Parameters
+        ----------
+        block : str
+            ``"coarse"`` or a patch name.
+        where : callable
+            Predicate on node coordinates (dim, n_nodes) -> (n_nodes,) bool.
+        components : sequence of int, optional
+            Components to prescribe (default all).
+        value : float, ndarray (dim,) or callable
+            Prescribed value; a callable takes node coordinates (dim, n) and returns (dim, n).
+        amplitude : callable, optional
+            Time factor a(t); the prescribed value is a(t) * value.
+        """
+        model = self.model(block)
+        nodes = np.nonzero(np.asarray(where(model.mesh.p), dtype=bool))[0]
+        if nodes.size == 0:
+            raise ValueError(f"Dirichlet condition on {block!r} selects no node")
+        self._dirichlet.append(_Dirichlet(block, where, components, value, amplitude, level))
+
+    def add_body_force(
+        self,
+        force: Any,
+        amplitude: Callable[[float], float] | None = None,
+        blocks: Sequence[str] | None = None,
+    ) -> None:
+        """Body force density (N/m³), split between the models by the partition weights.
+
+        ``force`` is a constant vector or a callable of x (dim, n_elems, n_qp).
+        """
+        self._loads.append(_Load("body", force, None, amplitude, blocks))
+
+    def add_traction(
+        self,
+        traction: Any,
+        where: Callable[[np.ndarray], np.ndarray] | None = None,
+        amplitude: Callable[[float], float] | None = None,
+        blocks: Sequence[str] | None = None,
+    ) -> None:
+        """Traction (Pa) on the physical boundary, split by the partition weights in the overlap.
+
+        Applied on the boundary facets (of the coarse mesh and of each patch mesh, on the coarse
+        boundary) whose midpoints satisfy ``where`` (default: the whole boundary). ``traction``
+        is a constant vector or a callable of (x, n) returning (dim, n_facets, n_qp).
+        """
+        self._loads.append(_Load("traction", traction, where, amplitude, blocks))
+
+    # ------------------------------------------------------------------ assembly
+    def _load_vectors(self, load: _Load) -> dict[str, np.ndarray]:
+        out: dict[str, np.ndarray] = {}
+        want = set(self._names if load.blocks is None else load.blocks)
+        cmodel = self.coarse
+        if "coarse" in want:
+            if load.kind == "body":
+                f = cmodel.body_force_vector(load.value)
+            else:
+                f = cmodel.traction_vector(self._facets(cmodel.mesh, load.where), load.value)
+            for pc in self.couplings:
+                imodel = pc.integration_model
+                if load.kind == "body":
+                    corr = imodel.body_force_vector(load.value, weight=pc.alpha_fine_overlap)
+                else:
+                    facets = self._filter(imodel.mesh, pc.integration_boundary_facets(), load.where)
+                    corr = imodel.traction_vector(facets, load.value, weight=pc.weight_function("fine"))
+                f = f - pc.coarse_transfer.T @ corr
+            out["coarse"] = f
+        for pc in self.couplings:
+            if pc.name not in want:
+                continue
+            fmodel = pc.fine_model
+            if load.kind == "body":
+                out[pc.name] = fmodel.body_force_vector(load.value, weight=pc.alpha_fine)
+            else:
+                facets = self._filter(fmodel.mesh, pc.outer_facets, load.where)
+                out[pc.name] = fmodel.traction_vector(facets, load.value, weight=pc.weight_function("fine"))
+        return out
+
+    @staticmethod
+    def _facets(mesh, where) -> np.ndarray:
+        return ArlequinProblem._filter(mesh, mesh.boundary_facets(), where)
+
+    @staticmethod
+    def _filter(mesh, facets: np.ndarray, where) -> np.ndarray:
+        if where is None or facets.size == 0:
+            return facets
+        return facets[np.asarray(where(_facet_midpoints(mesh, facets)), dtype=bool)]
+
+    def system(self) -> CoupledSystem:
+        """The coupled algebraic system (blocks, coupling and Dirichlet constraints, loads)."""
+        couplings = self.couplings
+        own = np.ones(self.coarse.mesh.nelements)
+        for pc in couplings:
+            own[pc.covered_coarse_cells] = 0.0
+        own_weight = np.repeat(own[:, None], self.coarse.scalar_basis().dx.shape[1], axis=1)
+        coarse_terms = [BlockTerm(self.coarse, own_weight)]
+        coarse_terms += [pc.coarse_overlap_term() for pc in couplings]
+        blocks = [Block("coarse", self.coarse, coarse_terms)]
+        blocks += [Block(pc.name, pc.fine_model, [pc.fine_term()]) for pc in couplings]
+        offsets = np.cumsum([0] + [b.n_dofs for b in blocks])
+        n = int(offsets[-1])
+        index = {b.name: int(o) for b, o in zip(blocks, offsets[:-1])}
+
+        constraints: list[LinearConstraint] = []
+        for pc in couplings:
+            cm = pc.coupling
+            c_coarse = sp.csr_matrix(
+                (cm.coarse.data, cm.coarse.indices, cm.coarse.indptr), shape=(cm.n_multipliers, n)
+            )
+            fine = sp.hstack(
+                [sp.csr_matrix((cm.n_multipliers, index[pc.name])), -cm.fine,
+                 sp.csr_matrix((cm.n_multipliers, n - index[pc.name] - cm.fine.shape[1]))],
+                format="csr",
+            )
+            constraints.append(
+                LinearConstraint((c_coarse + fine).tocsr(), None, f"coupling:{pc.name}", kind="coupling")
+            )
+        for k, bc in enumerate(self._dirichlet):
+            constraints.append(self._dirichlet_rows(bc, index[bc.block], n, k))
+
+        parts = []
+        for load in self._loads:
+            vecs = self._load_vectors(load)
+            full = np.zeros(n)
+            for name, vec in vecs.items():
+                full[index[name] : index[name] + vec.size] += vec
+            parts.append((full, load.amplitude))
+
+        def load_fn(t: float, parts=parts, n=n) -> np.ndarray:
+            f = np.zeros(n)
+            for vec, amp in parts:
+                f += vec if amp is None else float(amp(t)) * vec
+            return f
+
+        return CoupledSystem(blocks, constraints, load_fn)
+
+    def _dirichlet_rows(self, bc: _Dirichlet, offset: int, n: int, k: int) -> LinearConstraint:
+        model = self.model(bc.block)
+        mesh = model.mesh
+        nodes = np.nonzero(np.asarray(bc.where(mesh.p), dtype=bool))[0]
+        d = int(model.n_components)
+        comps = list(range(d)) if bc.components is None else list(bc.components)
+        if any(c < 0 or c >= d for c in comps):
+            raise ValueError(f"Dirichlet components must lie in [0, {d}), got {comps}")
+        dofs = (nodes[None, :] * d + np.array(comps)[:, None]).T.ravel()
+        if callable(bc.value):
+            vals = np.asarray(bc.value(mesh.p[:, nodes]), dtype=float).reshape(d, -1)[comps].T.ravel()
+        else:
+            v = np.broadcast_to(np.asarray(bc.value, dtype=float).reshape(-1), (d,))
+            vals = np.tile(v[comps], nodes.size)
+        rows = sp.csr_matrix(
+            (np.ones(dofs.size), (np.arange(dofs.size), offset + dofs)), shape=(dofs.size, n)
+        )
+        rhs = vals if bc.amplitude is None else (lambda t, vals=vals, a=bc.amplitude: float(a(t)) * vals)
+        return LinearConstraint(rows, rhs, f"dirichlet:{bc.block}:{k}", level=bc.level, kind="dirichlet")
+
