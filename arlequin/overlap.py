@@ -257,9 +257,9 @@ def _intersection_2d(coarse: Mesh, fine: Mesh) -> Overlap:
     flip = signed < 0
     tri[flip] = tri[flip][:, [0, 2, 1]]
     n = tri.shape[0]
-    p = tri.reshape(-1, 2).T
+    p = np.ascontiguousarray(tri.reshape(-1, 2).T)
     t = np.arange(3 * n).reshape(n, 3).T
-    mesh = MeshTri(p, t, validate=False) if "validate" in MeshTri.__dataclass_fields__ else MeshTri(p, t)
+    mesh = MeshTri(p, np.ascontiguousarray(t))
     fcells = np.repeat(fi[poly_of_tri], 3)
     ccells = np.repeat(ci[poly_of_tri], 3)
     p_coarse = interpolation_matrix(coarse, ccells, _simplex_ref(coarse, ccells, p))

@@ -94,6 +94,15 @@ def _columns(rng: np.random.Generator, n_total: int, length: float, i0: int, i1:
     return x, x[i0 + nb] - x[i0]
 
 
+def _breakpoints(segments, counts, rng) -> np.ndarray:
+    """Random nodes on consecutive segments, keeping every segment end exactly (band edges)."""
+    pts = [np.array([segments[0][0]])]
+    for (s0, s1), k in zip(segments, counts):
+        inner = s0 + np.cumsum(_spacing(k, s1 - s0, rng))[:-1]
+        pts.append(np.concatenate([inner, [s1]]))
+    return np.concatenate(pts)
+
+
 def _perturb(mesh, rng, axes, amount, keep):
     """Move interior nodes randomly along ``axes`` by up to ``amount`` x local spacing."""
     p = mesh.p.copy()
@@ -125,8 +134,7 @@ def _build_1d(rng, mesh_kind):
         b = x[i1] - rng.uniform(0.1, 0.4) * (x[i1] - x[i1 - 1])
         # fine nodes: random, with the band inner edges a + w and b - w as nodes
         segs = [(a, a + w), (a + w, b - w), (b - w, b)]
-        pts = [np.concatenate([[s0], s0 + np.cumsum(_spacing(k, s1 - s0, rng))]) for (s0, s1), k in zip(segs, (4, 9, 4))]
-        fine = skfem.MeshLine(np.unique(np.concatenate(pts)))
+        fine = skfem.MeshLine(_breakpoints(segs, (4, 9, 4), rng))
     return coarse, fine, w
 
 
@@ -160,8 +168,7 @@ def _build_2d(rng, mesh_kind, axisymmetric):
         a = s[i0] + rng.uniform(0.1, 0.4) * (s[i0 + 1] - s[i0])
         b = s[i1] - rng.uniform(0.1, 0.4) * (s[i1] - s[i1 - 1])
         segs = [(a, a + w), (a + w, b - w), (b - w, b)]
-        pts = [np.concatenate([[s0], s0 + np.cumsum(_spacing(k, s1 - s0, rng))]) for (s0, s1), k in zip(segs, (3, 10, 3))]
-        sf = np.unique(np.concatenate(pts))
+        sf = _breakpoints(segs, (3, 10, 3), rng)
         tf = np.concatenate([[0.0], np.cumsum(_spacing(7, width, rng))])
         fine = grid(sf, tf, "tri")
         fine = _perturb(fine, rng, [across], [0.2 * width / 7], lambda p: np.ones(p.shape[1], bool))

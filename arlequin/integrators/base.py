@@ -362,29 +362,79 @@ def unilateral_block_power(
     return -ops.block_dots(g.T @ lam, x)
 
 
-def _factor_checked(mat: sp.spmatrix, what: str, names: Callable[[int], str] | None = None):
-    """splu of a square sparse matrix, refusing (numerically) singular ones with a clear message."""
-    mat = sp.csc_matrix(mat)
+class ScaledLU:
+    """Sparse LU (SuperLU) of a symmetric matrix after symmetric diagonal scaling ``D A D``.
+
+    ``D_ii = |A_ii|^{-1/2}``; rows with a zero diagonal (multiplier rows of a saddle point) get
+    the inverse norm of their scaled row, so that stiffness, mass and constraint rows of very
+    different units become commensurate. A pivot below ``1e-14`` of the largest one (after
+    scaling) means linearly dependent rows: :class:`ConstraintError`.
+
+    Parameters
+    ----------
+    mat : sparse, shape (N, N)
+    what : str
+        Name of the matrix for the error message.
+    names : callable, optional
+        Row index -> description, for the error message.
+    spd : bool
+        Symmetric positive definite: symmetric ordering, diagonal pivots.
+    """
+
+    def __init__(self, mat: sp.spmatrix, what: str, names: Callable[[int], str] | None = None,
+                 spd: bool = False) -> None:
+        mat = sp.csr_matrix(mat)
+        n = mat.shape[0]
+        diag = np.abs(mat.diagonal())
+        d = np.zeros(n)
+        nz = diag > 0.0
+        d[nz] = 1.0 / np.sqrt(diag[nz])
+        if not np.all(nz):
+            scaled_cols = sp.csr_matrix(mat[~nz] @ sp.diags(d))
+            norms = np.sqrt(np.asarray(scaled_cols.multiply(scaled_cols).sum(axis=1)).ravel())
+            bad = np.nonzero(norms == 0.0)[0]
+            if bad.size:
+                i = int(np.nonzero(~nz)[0][bad[0]])
+                where = f" ({names(i)})" if names is not None else ""
+                raise ConstraintError(f"{what} has an empty row {i}{where}")
+            d[~nz] = 1.0 / norms
+        self.d = d
+        scaled = sp.csc_matrix(sp.diags(d) @ mat @ sp.diags(d))
+        try:
+            if spd:
+                self.lu = spla.splu(scaled, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0)
+            else:
+                self.lu = spla.splu(scaled)
+        except RuntimeError as exc:
+            raise ConstraintError(
+                f"{what} is singular ({exc}): the constraint rows are linearly dependent"
+            ) from exc
+        piv = np.abs(self.lu.U.diagonal())
+        tiny = np.nonzero(~(piv > 1e-14 * piv.max()))[0] if piv.size else np.zeros(0, int)
+        if tiny.size:
+            where = ""
+            if names is not None:
+                where = f" (near {names(int(self.lu.perm_c[tiny[0]]) if spd else int(tiny[0]))})"
+            raise ConstraintError(
+                f"{what} is numerically singular: {tiny.size} pivot(s) below 1e-14 of the "
+                f"largest after scaling{where}; the constraint rows are linearly dependent (e.g. "
+                "a Dirichlet condition on dofs that the mediator rows already tie, or duplicate "
+                "rows)"
+            )
+        self.shape = mat.shape
+
+    def solve(self, rhs: np.ndarray) -> np.ndarray:
+        """Solve A x = rhs; rhs of shape (N,) or (N, k)."""
+        d = self.d if rhs.ndim == 1 else self.d[:, None]
+        return d * self.lu.solve(np.ascontiguousarray(d * rhs))
+
+
+def _factor_checked(mat: sp.spmatrix, what: str, names: Callable[[int], str] | None = None,
+                    spd: bool = False) -> ScaledLU | None:
+    """:class:`ScaledLU` of a square sparse matrix (None if it is empty)."""
     if mat.shape[0] == 0:
         return None
-    try:
-        lu = spla.splu(mat, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0)
-    except RuntimeError as exc:
-        raise ConstraintError(f"{what} is singular ({exc}): the constraint rows are dependent") from exc
-    d = np.abs(lu.U.diagonal())
-    scale = d.max() if d.size else 1.0
-    tiny = np.nonzero(d <= 1e-11 * scale)[0]
-    if tiny.size or not np.all(np.isfinite(d)):
-        where = ""
-        if names is not None and tiny.size:
-            row = int(lu.perm_c[tiny[0]]) if hasattr(lu, "perm_c") else int(tiny[0])
-            where = f" (first dependent row: {names(row)})"
-        raise ConstraintError(
-            f"{what} is numerically singular: {tiny.size} pivot(s) below 1e-11 of the largest"
-            f"{where}; the constraint rows are linearly dependent (e.g. a Dirichlet condition on "
-            "dofs that the mediator rows already tie, or duplicate rows)"
-        )
-    return lu
+    return ScaledLU(mat, what, names, spd)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -642,7 +692,7 @@ class Integrator:
             return x
         if self.ops.lumped:
             s = (b @ sp.diags(self.ops.inv_mass) @ b.T).tocsc()
-            lu = _factor_checked(s, "the initial-condition projection matrix B M⁻¹ Bᵀ")
+            lu = _factor_checked(s, "the initial-condition projection matrix B M⁻¹ Bᵀ", spd=True)
             return x + self.ops.inv_mass * (b.T @ lu.solve(r))
         mat = sp.bmat([[self.ops.mass, b.T], [b, None]], format="csc")
         lu = _factor_checked(mat, "the initial-condition projection saddle point")

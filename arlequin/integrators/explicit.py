@@ -73,7 +73,9 @@ class _ImpulseSolver:
                         return f"row {i - sl.start} of constraint {name!r}"
                 return f"row {i}"
 
-            self.lu = _factor_checked(s, "the impulse matrix B M⁻¹ Bᵀ of the equality rows", row_name)
+            self.lu = _factor_checked(
+                s, "the impulse matrix B M⁻¹ Bᵀ of the equality rows", row_name, spd=True
+            )
         else:
             self.s_ee = None
             self.lu = None
@@ -92,7 +94,7 @@ class _ImpulseSolver:
         if self.m_e == 0:
             fac = self._cache.get(key)
             if fac is None:
-                fac = ("lu", _factor_checked(s_aa, "the impulse matrix of the active unilateral rows"))
+                fac = ("lu", _factor_checked(s_aa, "the impulse matrix of the active rows", spd=True))
                 self._cache = {key: fac}
             return np.zeros(0), fac[1].solve(r_a)
         s_ae = (g_a @ sp.diags(minv) @ self.rows.matrix.T).tocsr()
@@ -117,7 +119,7 @@ class _ImpulseSolver:
         fac = self._cache.get(key)
         if fac is None:
             full = sp.bmat([[self.s_ee, s_ae.T], [s_ae, s_aa]], format="csc")
-            fac = ("full", _factor_checked(full, "the impulse matrix with the active rows"))
+            fac = ("full", _factor_checked(full, "the impulse matrix with the active rows", spd=True))
             self._cache = {key: fac}
         sol = fac[1].solve(np.concatenate([r_e, r_a]))
         return sol[: self.m_e], sol[self.m_e :]

@@ -147,7 +147,7 @@ class ImplicitIntegrator(Integrator):
             sol = lu.solve(np.concatenate([r, target]))
             a, lam = sol[: self.ops.n], sol[self.ops.n :]
         else:
-            a = r / m if self.ops.lumped else _factor_checked(sp.csc_matrix(m), "the mass").solve(r)
+            a = r / m if self.ops.lumped else _factor_checked(sp.csc_matrix(m), "the mass", spd=True).solve(r)
             lam = np.zeros(0)
         self.a = a
         self._lam = lam

@@ -162,7 +162,7 @@ def stable_time_step(
                 s_lu = _s_lu
                 if s_lu is None:
                     s = (_rows.matrix @ sp.diags(1.0 / m) @ _rows.matrix.T).tocsc()
-                    s_lu = _factor_checked(s, "B M⁻¹ Bᵀ")
+                    s_lu = _factor_checked(s, "B M⁻¹ Bᵀ", spd=True)
                 btt = bt.T.tocsr()
 
                 def project(y: np.ndarray) -> np.ndarray:
