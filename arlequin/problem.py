@@ -199,12 +199,12 @@ class PatchCoupling:
         mode = self.weights.mode
         if mode == "nodal":
             nodal = fn(mesh.p, self.distance(mesh.p), self.gluing_width)
-            return np.asarray(basis.interpolate(np.asarray(nodal, dtype=float)).value)
+            return np.asarray(basis.interpolate(np.asarray(nodal, dtype=float)))
         if mode == "cell":
             c = cell_centroids(mesh)
             per_cell = np.asarray(fn(c, self.distance(c), self.gluing_width), dtype=float)
             return np.repeat(per_cell[:, None], basis.dx.shape[1], axis=1)
-        x = np.asarray(basis.global_coordinates().value)
+        x = np.asarray(basis.global_coordinates())
         return np.broadcast_to(fn(x, self.distance(x), self.gluing_width), basis.dx.shape).copy()
 
     def weight_function(self, which: str) -> Callable[[np.ndarray], np.ndarray]:

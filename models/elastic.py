@@ -160,7 +160,7 @@ class LinearElastic:
 
     def quadrature_points(self) -> np.ndarray:
         """Physical quadrature points, shape (dim, n_elems, n_qp), in m."""
-        return np.asarray(self.basis.global_coordinates().value)
+        return np.asarray(self.basis.global_coordinates())
 
     def nodal_dofs(self) -> np.ndarray:
         """Dof indices per node, shape (dim, n_nodes)."""
@@ -191,7 +191,7 @@ class LinearElastic:
         if weight is None:
             return np.ones(shape)
         if callable(weight):
-            values = np.asarray(weight(np.asarray(basis.global_coordinates().value)), dtype=float)
+            values = np.asarray(weight(np.asarray(basis.global_coordinates())), dtype=float)
             values = np.broadcast_to(values, shape)
         else:
             values = np.broadcast_to(np.asarray(weight, dtype=float), shape)
@@ -275,7 +275,7 @@ class LinearElastic:
         (dim, n_elems, n_qp). For 1D bars the force is per unit volume (multiplied by the area).
         """
         alpha = self.weight_at_quadrature(weight)
-        fq = _vector_field(force, np.asarray(self.basis.global_coordinates().value), self.dim)
+        fq = _vector_field(force, np.asarray(self.basis.global_coordinates()), self.dim)
 
         @LinearForm
         def form(v, w):
@@ -298,8 +298,8 @@ class LinearElastic:
             return np.zeros(self.n_dofs)
         fb = self.facet_basis(facets)
         alpha = self.weight_at_quadrature(weight, basis=fb)
-        x = fb.global_coordinates().value
-        n = fb.normals.value
+        x = np.asarray(fb.global_coordinates())
+        n = np.asarray(fb.normals)
         if callable(traction):
             tq = np.asarray(traction(x, n), dtype=float)
         else:
@@ -327,8 +327,8 @@ class LinearElastic:
         out = np.zeros((3, 3) + g.shape[2:])
         hoop = 0.0
         if self.kind == "axisymmetric":
-            x = np.asarray(self.basis.global_coordinates().value)
-            hoop = uq.value[0] / x[0]
+            x = np.asarray(self.basis.global_coordinates())
+            hoop = np.asarray(uq)[0] / x[0]
         tr = np.einsum("ii...", eps) + hoop
         out[:d, :d] = 2.0 * mu * eps
         for i in range(d):

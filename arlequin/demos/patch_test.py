@@ -19,7 +19,6 @@ Two numbers are reported (fractions, see ``docs/theory.md``):
 
 from __future__ import annotations
 
-import json
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -29,7 +28,7 @@ from ..integrators.static import solve_static
 from ..problem import ArlequinProblem, Patch
 from ..patches import refine_region
 
-__all__ = ["PatchTestResult", "run_patch_test"]
+__all__ = ["PatchTestResult", "build_patch_test_problem", "run_patch_test"]
 
 DIMS = ("1", "2", "3", "axi")
 
@@ -195,24 +194,22 @@ def _build_3d(rng, mesh_kind):
     return coarse, fine, w
 
 
-def run_patch_test(
+def build_patch_test_problem(
     dim: str | int = "2",
     coupling: str = "H1",
     weights: str = "ramp",
     mediator: str = "coarse",
     mesh: str = "nested",
     seed: int = 0,
-) -> PatchTestResult:
-    """Run one random patch test; see the module docstring.
+):
+    """Build the random patch-test problem (see :func:`run_patch_test`).
 
-    Parameters
-    ----------
-    dim : {"1", "2", "3", "axi"}
-    coupling : {"L2", "H1"}
-    weights : {"constant", "ramp"}
-    mediator : {"coarse", "fine"}
-    mesh : {"nested", "nonnested"}
-    seed : int
+    Returns
+    -------
+    problem : ArlequinProblem
+        With tractions and rigid-motion supports applied.
+    exact : callable
+        The exact displacement u(x) = A x, x of shape (dim, ...) (m).
     """
     from ..models import IsotropicElastic, LinearElastic
 
@@ -233,14 +230,7 @@ def run_patch_test(
     material = IsotropicElastic(young=200e9, poisson=0.3, density=7800.0)
     coarse = LinearElastic(coarse_mesh, material, kind)
     fine = LinearElastic(fine_mesh, material, kind)
-    patch = Patch(
-        fine,
-        gluing_width=w,
-        weights=weights,
-        coupling=coupling,
-        mediator=mediator,
-        overlap_method="auto",
-    )
+    patch = Patch(fine, gluing_width=w, weights=weights, coupling=coupling, mediator=mediator)
     problem = ArlequinProblem(coarse, [patch])
     d = coarse_mesh.dim()
     a = _linear_field(rng, d, axi)
@@ -255,20 +245,47 @@ def run_patch_test(
 
     problem.add_traction(traction)
     _remove_rigid_motions(problem, coarse_mesh, exact, axi)
+    return problem, exact
+
+
+def run_patch_test(
+    dim: str | int = "2",
+    coupling: str = "H1",
+    weights: str = "ramp",
+    mediator: str = "coarse",
+    mesh: str = "nested",
+    seed: int = 0,
+) -> PatchTestResult:
+    """Run one random patch test; see the module docstring.
+
+    Parameters
+    ----------
+    dim : {"1", "2", "3", "axi"}
+    coupling : {"L2", "H1"}
+    weights : {"constant", "ramp"}
+    mediator : {"coarse", "fine"}
+    mesh : {"nested", "nonnested"}
+    seed : int
+    """
+    problem, exact = build_patch_test_problem(dim, coupling, weights, mediator, mesh, seed)
+    dim = str(dim)
+    coarse_mesh = problem.coarse.mesh
+    fine_mesh = problem.patches[0].model.mesh
     result = solve_static(problem)
-    u_exact = {"coarse": _nodal(exact, coarse_mesh), problem.block_names[1]: _nodal(exact, fine_mesh)}
+    name = problem.block_names[1]
+    u_exact = {"coarse": _nodal(exact, coarse_mesh), name: _nodal(exact, fine_mesh)}
     scale = max(np.abs(v).max() for v in u_exact.values())
     max_error = max(np.abs(result.displacements[k] - v).max() for k, v in u_exact.items()) / scale
     sp_sys = result.saddle_point
-    u_full = np.concatenate([u_exact["coarse"], u_exact[problem.block_names[1]]])
+    u_full = np.concatenate([u_exact["coarse"], u_exact[name]])
     lam = sp_sys.best_multipliers(u_full)
     residual = sp_sys.residual(u_full, lam)
     pc = problem.couplings[0]
     return PatchTestResult(
         max_error=float(max_error),
         exact_residual=float(residual),
-        n_coarse_dofs=int(coarse.n_dofs),
-        n_fine_dofs=int(fine.n_dofs),
+        n_coarse_dofs=int(problem.coarse.n_dofs),
+        n_fine_dofs=int(problem.patches[0].model.n_dofs),
         n_multipliers=int(pc.coupling.n_multipliers),
         dim=dim,
         coupling=coupling,
@@ -312,10 +329,3 @@ def _remove_rigid_motions(problem: ArlequinProblem, mesh, exact, axi: bool) -> N
 def _is(x, origin_pt, tol):
     return np.all(np.abs(x - np.asarray(origin_pt)[:, None]) < tol, axis=0)
 
-
-def main_json(result: PatchTestResult, path: str) -> None:
-    keys = ("max_error", "exact_residual", "n_coarse_dofs", "n_fine_dofs", "n_multipliers")
-    data = {k: getattr(result, k) for k in keys}
-    data.update({k: v for k, v in result.to_json().items() if k not in data})
-    with open(path, "w", encoding="utf-8") as fh:
-        json.dump(data, fh, indent=2)
