@@ -1,0 +1,71 @@
+"""Package boundaries and the command line."""
+
+from __future__ import annotations
+
+import ast
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import arlequin
+from arlequin.cli import main
+
+ROOT = Path(arlequin.__file__).resolve().parent
+
+
+def _imports(path: Path) -> set[str]:
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    out = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            out.update(a.name for a in node.names)
+        elif isinstance(node, ast.ImportFrom):
+            mod = node.module or ""
+            out.add("." * node.level + mod)
+    return out
+
+
+def test_core_never_imports_the_models():
+    offenders = []
+    for path in ROOT.rglob("*.py"):
+        rel = path.relative_to(ROOT)
+        if rel.parts[0] in ("demos",) or rel.name == "cli.py":
+            continue
+        for name in _imports(path):
+            if "models" in name.split("."):
+                offenders.append(f"{rel}: {name}")
+    assert not offenders, offenders
+
+
+def test_models_are_shipped_as_arlequin_models():
+    import arlequin.models as models
+
+    assert Path(models.__file__).resolve().parent.name == "models"
+    assert hasattr(models, "LinearElastic")
+
+
+def test_cli_patch_test_writes_json(tmp_path, capsys):
+    out = tmp_path / "pt.json"
+    assert main(["patch-test", "--dim", "1", "--json", str(out)]) == 0
+    data = json.loads(out.read_text())
+    for key in ("max_error", "exact_residual", "n_coarse_dofs", "n_fine_dofs", "n_multipliers"):
+        assert key in data
+    assert data["max_error"] <= 1e-10  # exact configuration (1D nested ramp, coarse mediator)
+    assert "max_error" in capsys.readouterr().out
+
+
+def test_cli_reports_errors_cleanly(capsys):
+    assert main(["patch-test", "--dim", "3", "--mesh", "nonnested"]) == 2
+    assert "error" in capsys.readouterr().err
+
+
+def test_console_script_entry_point():
+    r = subprocess.run(
+        [sys.executable, "-m", "arlequin.cli", "patch-test", "--dim", "1"],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert r.returncode == 0, r.stderr
+    assert "max_error" in r.stdout
