@@ -106,11 +106,19 @@ def _interior_points(mesh: Mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     nv = mesh.t.shape[0]
     simplex = nv == dim + 1
     if simplex:
-        bary = np.array([np.full(dim + 1, 1.0 / (dim + 1)), np.linspace(1, 2, dim + 1), np.linspace(3, 1, dim + 1)])
+        bary = np.array(
+            [
+                np.full(dim + 1, 1.0 / (dim + 1)),
+                np.linspace(1, 2, dim + 1),
+                np.linspace(3, 1, dim + 1),
+            ]
+        )
         bary = bary / bary.sum(axis=1, keepdims=True)
         refs = bary[:, 1:].T  # (dim, 3)
     else:
-        refs = np.array([np.full(dim, 0.5), np.linspace(0.2, 0.7, dim), np.linspace(0.85, 0.3, dim)]).T
+        refs = np.array(
+            [np.full(dim, 0.5), np.linspace(0.2, 0.7, dim), np.linspace(0.85, 0.3, dim)]
+        ).T
     n_ref = refs.shape[1]
     cells = np.repeat(np.arange(mesh.nelements), n_ref)
     ref = np.tile(refs, (1, mesh.nelements))
@@ -155,7 +163,9 @@ def build_overlap(coarse: Mesh, fine: Mesh, method: str = "auto", tol: float = 0
         Mismatched dimensions, a patch outside the coarse mesh, or an unsupported non-nested case.
     """
     if method not in ("auto", "nested", "intersection"):
-        raise ValueError(f"overlap method must be 'auto', 'nested' or 'intersection', got {method!r}")
+        raise ValueError(
+            f"overlap method must be 'auto', 'nested' or 'intersection', got {method!r}"
+        )
     if coarse.dim() != fine.dim():
         raise OverlapError(
             f"mismatched dimensions: coarse mesh is {coarse.dim()}D, patch mesh is {fine.dim()}D"

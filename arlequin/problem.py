@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
+
 from .coupling import CouplingMatrices, MediatorError, coupling_matrices
 from .geometry import distance_to_facets, facet_coordinates
 from .locate import cell_centroids, cell_sizes, locate_points
@@ -103,7 +104,9 @@ class PatchCoupling:
         self.fine_model = patch.model
         self.weights: PartitionWeights = patch.weights  # type: ignore[assignment]
         cmesh, fmesh = coarse_model.mesh, patch.model.mesh
-        self.overlap: Overlap = build_overlap(cmesh, fmesh, patch.overlap_method, patch.boundary_tol)
+        self.overlap: Overlap = build_overlap(
+            cmesh, fmesh, patch.overlap_method, patch.boundary_tol
+        )
         self.n_components = int(coarse_model.n_components)
         if int(patch.model.n_components) != self.n_components:
             raise ValueError(
@@ -164,7 +167,9 @@ class PatchCoupling:
         centroids = cell_centroids(fmesh)
         if self.patch.gluing_region is not None:
             fine_gluing = np.asarray(self.patch.gluing_region(centroids), dtype=bool)
-            d_nodes = self.distance(fmesh.p) if self.interior_facets.size else np.zeros(fmesh.nvertices)
+            d_nodes = (
+                self.distance(fmesh.p) if self.interior_facets.size else np.zeros(fmesh.nvertices)
+            )
             width = float(d_nodes[fmesh.t[:, fine_gluing]].max()) if fine_gluing.any() else 0.0
         else:
             if self.interior_facets.size == 0:
@@ -189,7 +194,9 @@ class PatchCoupling:
         self.fine_gluing_cells = np.nonzero(fine_gluing)[0]
         self.gluing_cells = np.nonzero(fine_gluing[self.overlap.fine_cells])[0]
         if self.gluing_cells.size == 0:
-            raise MediatorError(f"empty gluing zone for {self.name}: it does not overlap the coarse mesh")
+            raise MediatorError(
+                f"empty gluing zone for {self.name}: it does not overlap the coarse mesh"
+            )
 
     # ------------------------------------------------------------------ weights
     def _weights_at(self, basis, which: str) -> np.ndarray:
@@ -347,7 +354,8 @@ class ArlequinProblem:
         """Per-patch overlap, weights and coupling matrices (built on first use)."""
         if self._couplings is None:
             self._couplings = [
-                PatchCoupling(self.coarse, p, self._names[i + 1]) for i, p in enumerate(self.patches)
+                PatchCoupling(self.coarse, p, self._names[i + 1])
+                for i, p in enumerate(self.patches)
             ]
         return self._couplings
 
@@ -431,7 +439,9 @@ class ArlequinProblem:
                     corr = imodel.body_force_vector(load.value, weight=pc.alpha_fine_overlap)
                 else:
                     facets = self._filter(imodel.mesh, pc.integration_boundary_facets(), load.where)
-                    corr = imodel.traction_vector(facets, load.value, weight=pc.weight_function("fine"))
+                    corr = imodel.traction_vector(
+                        facets, load.value, weight=pc.weight_function("fine")
+                    )
                 f = f - pc.coarse_transfer.T @ corr
             out["coarse"] = f
         for pc in self.couplings:
@@ -442,7 +452,9 @@ class ArlequinProblem:
                 out[pc.name] = fmodel.body_force_vector(load.value, weight=pc.alpha_fine)
             else:
                 facets = self._filter(fmodel.mesh, pc.outer_facets, load.where)
-                out[pc.name] = fmodel.traction_vector(facets, load.value, weight=pc.weight_function("fine"))
+                out[pc.name] = fmodel.traction_vector(
+                    facets, load.value, weight=pc.weight_function("fine")
+                )
         return out
 
     @staticmethod
@@ -477,12 +489,17 @@ class ArlequinProblem:
                 (cm.coarse.data, cm.coarse.indices, cm.coarse.indptr), shape=(cm.n_multipliers, n)
             )
             fine = sp.hstack(
-                [sp.csr_matrix((cm.n_multipliers, index[pc.name])), -cm.fine,
-                 sp.csr_matrix((cm.n_multipliers, n - index[pc.name] - cm.fine.shape[1]))],
+                [
+                    sp.csr_matrix((cm.n_multipliers, index[pc.name])),
+                    -cm.fine,
+                    sp.csr_matrix((cm.n_multipliers, n - index[pc.name] - cm.fine.shape[1])),
+                ],
                 format="csr",
             )
             constraints.append(
-                LinearConstraint((c_coarse + fine).tocsr(), None, f"coupling:{pc.name}", kind="coupling")
+                LinearConstraint(
+                    (c_coarse + fine).tocsr(), None, f"coupling:{pc.name}", kind="coupling"
+                )
             )
         for k, bc in enumerate(self._dirichlet):
             constraints.append(self._dirichlet_rows(bc, index[bc.block], n, k))
@@ -513,13 +530,20 @@ class ArlequinProblem:
             raise ValueError(f"Dirichlet components must lie in [0, {d}), got {comps}")
         dofs = (nodes[None, :] * d + np.array(comps)[:, None]).T.ravel()
         if callable(bc.value):
-            vals = np.asarray(bc.value(mesh.p[:, nodes]), dtype=float).reshape(d, -1)[comps].T.ravel()
+            vals = (
+                np.asarray(bc.value(mesh.p[:, nodes]), dtype=float).reshape(d, -1)[comps].T.ravel()
+            )
         else:
             v = np.broadcast_to(np.asarray(bc.value, dtype=float).reshape(-1), (d,))
             vals = np.tile(v[comps], nodes.size)
         rows = sp.csr_matrix(
             (np.ones(dofs.size), (np.arange(dofs.size), offset + dofs)), shape=(dofs.size, n)
         )
-        rhs = vals if bc.amplitude is None else (lambda t, vals=vals, a=bc.amplitude: float(a(t)) * vals)
-        return LinearConstraint(rows, rhs, f"dirichlet:{bc.block}:{k}", level=bc.level, kind="dirichlet")
-
+        rhs = (
+            vals
+            if bc.amplitude is None
+            else (lambda t, vals=vals, a=bc.amplitude: float(a(t)) * vals)
+        )
+        return LinearConstraint(
+            rows, rhs, f"dirichlet:{bc.block}:{k}", level=bc.level, kind="dirichlet"
+        )

@@ -71,7 +71,9 @@ class LinearConstraint:
 
     def __post_init__(self) -> None:
         if self.level not in ("displacement", "velocity"):
-            raise ValueError(f"constraint level must be 'displacement' or 'velocity', got {self.level!r}")
+            raise ValueError(
+                f"constraint level must be 'displacement' or 'velocity', got {self.level!r}"
+            )
 
     @property
     def n_rows(self) -> int:
@@ -187,14 +189,18 @@ class CoupledSystem:
         """Weighted stiffness of one block (linear models), shape (n_b, n_b)."""
         key = f"K:{block.name}"
         if key not in self._cache:
-            self._cache[key] = sum((t.stiffness() for t in block.terms[1:]), block.terms[0].stiffness()).tocsr()
+            self._cache[key] = sum(
+                (t.stiffness() for t in block.terms[1:]), block.terms[0].stiffness()
+            ).tocsr()
         return self._cache[key]
 
     def block_mass(self, block: Block) -> sp.csr_matrix:
         """Weighted consistent mass of one block, shape (n_b, n_b)."""
         key = f"M:{block.name}"
         if key not in self._cache:
-            self._cache[key] = sum((t.mass() for t in block.terms[1:]), block.terms[0].mass()).tocsr()
+            self._cache[key] = sum(
+                (t.mass() for t in block.terms[1:]), block.terms[0].mass()
+            ).tocsr()
         return self._cache[key]
 
     def stiffness(self) -> sp.csr_matrix:

@@ -62,7 +62,7 @@ class PartitionWeights:
             raise ValueError(f"weight floor epsilon must lie in (0, 1), got epsilon={self.epsilon}")
 
     def alpha_coarse(self, x: np.ndarray, d: np.ndarray, width: float) -> np.ndarray:
-        """α_coarse at points ``x`` (dim, ...) with distances ``d`` (...) to the interior boundary."""
+        """α_coarse at points ``x`` (dim, ...), distances ``d`` (...) to the interior boundary."""
         raise NotImplementedError
 
     def alpha_fine(self, x: np.ndarray, d: np.ndarray, width: float) -> np.ndarray:

@@ -14,9 +14,9 @@ import json
 
 import numpy as np
 import skfem
+from arlequin.models import IsotropicElastic, LinearElastic
 
 from arlequin import ArlequinProblem, Patch, refine_region, solve_static
-from arlequin.models import IsotropicElastic, LinearElastic
 
 
 def error(n: int, weights: str, mediator: str, coupling: str = "L2") -> float:
@@ -25,7 +25,8 @@ def error(n: int, weights: str, mediator: str, coupling: str = "L2") -> float:
     fm = refine_region(cm, levels=2, box=((0.5, 0.0), (1.5, 1.0)))
     coarse, fine = LinearElastic(cm, steel), LinearElastic(fm, steel)
     problem = ArlequinProblem(
-        coarse, [Patch(fine, gluing_width=0.25, weights=weights, mediator=mediator, coupling=coupling)]
+        coarse,
+        [Patch(fine, gluing_width=0.25, weights=weights, mediator=mediator, coupling=coupling)],
     )
     a = np.array([[1e-3, 2e-4], [-3e-4, -5e-4]])
     stress = coarse.stress_at_quadrature(np.einsum("ij,jn->ni", a, cm.p).ravel())[:2, :2, 0, 0]

@@ -35,6 +35,7 @@ __all__ = ["KINDS", "IsotropicElastic", "LinearElastic", "scalar_element_for"]
 
 KINDS = ("1d", "plane_strain", "plane_stress", "axisymmetric", "3d")
 
+
 @dataclass(frozen=True)
 class IsotropicElastic:
     """Isotropic linear elastic material.
@@ -140,7 +141,7 @@ class LinearElastic:
         self.basis = Basis(mesh, self.element, intorder=self.intorder)
 
     def scalar_basis(self) -> Basis:
-        """Scalar first-order basis with the model's quadrature (for weights at quadrature points)."""
+        """Scalar first-order basis with the model's quadrature (weights at quadrature points)."""
         return self.basis.with_element(self.scalar_element)
 
     # ------------------------------------------------------------------ construction helpers
@@ -285,9 +286,13 @@ class LinearElastic:
 
     def facet_basis(self, facets: np.ndarray) -> FacetBasis:
         """scikit-fem facet basis on the given boundary facets."""
-        return FacetBasis(self.mesh, self.element, facets=np.asarray(facets), intorder=self.intorder)
+        return FacetBasis(
+            self.mesh, self.element, facets=np.asarray(facets), intorder=self.intorder
+        )
 
-    def traction_vector(self, facets: np.ndarray, traction, weight: WeightLike = None) -> np.ndarray:
+    def traction_vector(
+        self, facets: np.ndarray, traction, weight: WeightLike = None
+    ) -> np.ndarray:
         """Load vector ∫_Γ α t·v (N) for a traction ``t`` (Pa) on boundary ``facets``.
 
         ``traction`` is a constant vector (dim,) or a callable of (x, n) with x and the outward
@@ -324,7 +329,7 @@ class LinearElastic:
         g = uq.grad
         d = self.dim
         eps = 0.5 * (g + np.swapaxes(g, 0, 1))
-        out = np.zeros((3, 3) + g.shape[2:])
+        out = np.zeros((3, 3, *g.shape[2:]))
         hoop = 0.0
         if self.kind == "axisymmetric":
             x = np.asarray(self.basis.global_coordinates())

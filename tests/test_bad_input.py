@@ -5,13 +5,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import skfem
+from arlequin.models import IsotropicElastic, LinearElastic
 
 from arlequin.coupling import MediatorError, coupling_matrices
 from arlequin.overlap import OverlapError
 from arlequin.patches import refine_region
 from arlequin.problem import ArlequinProblem, Patch
 from arlequin.weights import CallableWeights, WeightSumError
-from arlequin.models import IsotropicElastic, LinearElastic
 
 STEEL = IsotropicElastic(young=210e9, poisson=0.3, density=7850.0)
 
@@ -75,7 +75,9 @@ def test_two_disjoint_patches_are_fine():
     f1 = refine_region(cm, levels=1, box=((0.0, 0.0), (0.75, 1.0)))
     f2 = refine_region(cm, levels=1, box=((1.25, 0.0), (2.0, 1.0)))
     c = LinearElastic(cm, STEEL)
-    problem = ArlequinProblem(c, [Patch(LinearElastic(f1, STEEL), 0.25), Patch(LinearElastic(f2, STEEL), 0.25)])
+    problem = ArlequinProblem(
+        c, [Patch(LinearElastic(f1, STEEL), 0.25), Patch(LinearElastic(f2, STEEL), 0.25)]
+    )
     assert len(problem.couplings) == 2
 
 
@@ -114,7 +116,9 @@ def test_mismatched_dimensions():
     fm = skfem.MeshLine(np.linspace(0.5, 1.5, 5))
     c = LinearElastic(cm, STEEL)
     f = LinearElastic(fm, STEEL)
-    with pytest.raises(ValueError, match="mismatched dimensions: coarse mesh is 2D, patch mesh is 1D"):
+    with pytest.raises(
+        ValueError, match="mismatched dimensions: coarse mesh is 2D, patch mesh is 1D"
+    ):
         ArlequinProblem(c, [Patch(f, gluing_width=0.25)]).couplings  # noqa: B018
 
 

@@ -13,9 +13,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import skfem
+from arlequin.models import IsotropicElastic, LinearElastic
 
 from arlequin.integrators.static import solve_static
-from arlequin.models import IsotropicElastic, LinearElastic
 from arlequin.patches import refine_region
 from arlequin.problem import ArlequinProblem, Patch
 
@@ -37,7 +37,8 @@ def free_zone_errors(n_coarse: int, coupling: str) -> tuple[float, float]:
     coarse = LinearElastic(coarse_mesh, material, "1d", area=1.0)
     fine = LinearElastic(fine_mesh, material, "1d", area=1.0)
     problem = ArlequinProblem(
-        coarse, [Patch(fine, gluing_width=0.1, weights="ramp", coupling=coupling, mediator="coarse")]
+        coarse,
+        [Patch(fine, gluing_width=0.1, weights="ramp", coupling=coupling, mediator="coarse")],
     )
     problem.add_body_force(lambda x: F0 * np.sin(np.pi * x))
     problem.add_dirichlet("coarse", lambda x: (x[0] < 1e-12) | (x[0] > 1 - 1e-12))

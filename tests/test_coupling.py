@@ -38,8 +38,9 @@ def test_linear_fields_and_rigid_motions_are_coupled_consistently(dim, mesh, cou
     cm, fm = problem.coarse.mesh, pc.fine_model.mesh
     d = cm.dim()
     rng = np.random.default_rng(0)
-    fields = [lambda x, a=rng.standard_normal((d, d)): a @ x]
-    fields.append(lambda x, c=rng.standard_normal(d): np.broadcast_to(c[:, None], x.shape))
+    a = rng.standard_normal((d, d))
+    c = rng.standard_normal(d)
+    fields = [lambda x: a @ x, lambda x: np.broadcast_to(c[:, None], x.shape)]
     if d == 2:
         fields.append(lambda x: np.array([-x[1], x[0]]))  # infinitesimal rotation
     if d == 3:
@@ -57,7 +58,9 @@ def test_scalar_l2_gram_sums_to_gluing_measure(dim, mesh, mediator):
     problem, _ = build_patch_test_problem(dim, "L2", "ramp", mediator, mesh, seed=4)
     pc = problem.couplings[0]
     axi = dim == "axi"
-    cm = coupling_matrices(pc.overlap, pc.gluing_cells, 1, "L2", mediator=mediator, axisymmetric=axi)
+    cm = coupling_matrices(
+        pc.overlap, pc.gluing_cells, 1, "L2", mediator=mediator, axisymmetric=axi
+    )
     fm = pc.fine_model.mesh
     lo, hi = fm.p.min(axis=1), fm.p.max(axis=1)
     w = pc.gluing_width

@@ -25,8 +25,8 @@ import numpy as np
 import skfem
 
 from ..integrators.static import solve_static
-from ..problem import ArlequinProblem, Patch
 from ..patches import refine_region
+from ..problem import ArlequinProblem, Patch
 
 __all__ = ["PatchTestResult", "build_patch_test_problem", "run_patch_test"]
 
@@ -152,8 +152,10 @@ def _build_2d(rng, mesh_kind, axisymmetric):
     def grid(a, b, kind):
         xs, ys = (b, a) if axisymmetric else (a, b)
         m = skfem.MeshQuad.init_tensor(xs, ys)
-        return m.to_meshtri() if kind == "tri" and hasattr(m, "to_meshtri") else (
-            skfem.MeshTri.init_tensor(xs, ys) if kind == "tri" else m
+        return (
+            m.to_meshtri()
+            if kind == "tri" and hasattr(m, "to_meshtri")
+            else (skfem.MeshTri.init_tensor(xs, ys) if kind == "tri" else m)
         )
 
     coarse = grid(s, t, cells)
@@ -328,4 +330,3 @@ def _remove_rigid_motions(problem: ArlequinProblem, mesh, exact, axi: bool) -> N
 
 def _is(x, origin_pt, tol):
     return np.all(np.abs(x - np.asarray(origin_pt)[:, None]) < tol, axis=0)
-

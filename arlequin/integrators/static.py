@@ -20,7 +20,13 @@ import scipy.sparse.linalg as spla
 
 from ..system import CoupledSystem
 
-__all__ = ["SaddlePoint", "SingularSystemError", "StaticResult", "assemble_saddle_point", "solve_static"]
+__all__ = [
+    "SaddlePoint",
+    "SingularSystemError",
+    "StaticResult",
+    "assemble_saddle_point",
+    "solve_static",
+]
 
 
 class SingularSystemError(ValueError):
@@ -84,7 +90,9 @@ class SaddlePoint:
         out = float(np.linalg.norm(r1) / scale1)
         if b.shape[0]:
             r2 = b @ u - self.constraint_rhs
-            scale2 = max(np.linalg.norm(abs(b) @ np.abs(u)), np.linalg.norm(self.constraint_rhs), 1e-300)
+            scale2 = max(
+                np.linalg.norm(abs(b) @ np.abs(u)), np.linalg.norm(self.constraint_rhs), 1e-300
+            )
             out = max(out, float(np.linalg.norm(r2) / scale2))
         return out
 
