@@ -1,0 +1,178 @@
+"""Unit tests of the level-set contact model (models/contact.py): geometry, statuses, protocol."""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+import skfem
+from arlequin.models import (
+    ContactConvergenceError,
+    ContactSurface,
+    DeformableContactPair,
+    IsotropicElastic,
+    LevelSetContact,
+    LevelSetObstacle,
+    LinearElastic,
+    PlaneObstacle,
+    RigidContactPair,
+    SignoriniContact,
+    SphereObstacle,
+    acoustic_impedance,
+)
+
+from arlequin.integrators import solve
+from arlequin.system import Block, BlockTerm, CoupledSystem
+
+STEEL = IsotropicElastic(210e9, 0.3, 7850.0)
+
+
+def test_obstacles_phi_and_gradient():
+    x = np.array([[0.0, 1.0, 3.0], [2.0, 0.0, 0.0]])
+    plane = PlaneObstacle([0.0, 0.5], [0.0, 2.0])  # free space y > 0.5
+    np.testing.assert_allclose(plane.phi(x), [1.5, -0.5, -0.5])
+    np.testing.assert_allclose(plane.gradient(x), [[0, 0, 0], [1, 1, 1]])
+    ball = SphereObstacle([0.0, 0.0], 1.0)
+    np.testing.assert_allclose(ball.phi(x), [1.0, 0.0, 2.0])
+    np.testing.assert_allclose(ball.gradient(x)[:, 0], [0.0, 1.0])
+    cavity = SphereObstacle([0.0, 0.0], 4.0, inside=True)
+    np.testing.assert_allclose(cavity.phi(x), [2.0, 3.0, 1.0])
+    ls = LevelSetObstacle(
+        lambda p: 1.0 - p[0], lambda p: np.vstack([-np.ones(p.shape[1]), 0 * p[1]])
+    )
+    np.testing.assert_allclose(ls.phi(x), [1.0, 0.0, -2.0])
+    with pytest.raises(ValueError, match="radius"):
+        SphereObstacle([0.0], -1.0)
+
+
+def test_acoustic_impedance_default_kappa():
+    # 1D: rho * sqrt(E / rho); 2D/3D: rho * c_d with the dilatational speed
+    assert acoustic_impedance(210e9, 7850.0) == pytest.approx(np.sqrt(210e9 * 7850.0))
+    m = 210e9 * 0.7 / (1.3 * 0.4)
+    assert acoustic_impedance(210e9, 7850.0, 0.3) == pytest.approx(np.sqrt(m * 7850.0))
+
+
+def test_surface_weights_2d_3d():
+    # vertex quadrature: the weights of a face sum to its measure
+    quad = skfem.MeshQuad.init_tensor(np.linspace(0, 0.3, 4), np.linspace(0, 1, 3))
+    s = ContactSurface(quad, where=lambda x: x[1] < 1e-9)
+    assert s.n_points == 4
+    np.testing.assert_allclose(s.weights, [0.05, 0.1, 0.1, 0.05])
+    axes = (np.linspace(0, 0.2, 3), np.linspace(0, 0.1, 2), np.linspace(0, 1, 2))
+    hexm = skfem.MeshHex.init_tensor(*axes)
+    s3 = ContactSurface(hexm, where=lambda x: x[2] < 1e-9)
+    assert s3.weights.sum() == pytest.approx(0.02)
+    # axisymmetric: ∫ 2πr over the disc of radius 0.3
+    s_axi = ContactSurface(quad, where=lambda x: x[1] < 1e-9, axisymmetric=True)
+    assert s_axi.weights.sum() == pytest.approx(np.pi * 0.3**2, rel=0.02)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_deformable_pair_gap_and_rows(dim):
+    """Two blocks apart by g: d_n = −g; G u is the linearised gap change (finite differences)."""
+    g = 1e-3
+    lat = [np.linspace(0, 1, 3)] * (dim - 1)
+    mk = skfem.MeshQuad if dim == 2 else skfem.MeshHex
+    top = LinearElastic(mk.init_tensor(*lat, np.linspace(g, 1 + g, 3)), STEEL)
+    bot = LinearElastic(mk.init_tensor(*lat, np.linspace(-1, 0, 3)), STEEL)
+    n = top.n_dofs + bot.n_dofs
+    slave = ContactSurface(top.mesh, where=lambda x: x[-1] < g + 0.1)
+    master = ContactSurface(bot.mesh, where=lambda x: x[-1] > -0.1, offset=top.n_dofs)
+    pair = DeformableContactPair(slave, master, n)
+    geo = pair.geometry(np.zeros(n))
+    np.testing.assert_allclose(geo.gap, -g)
+    np.testing.assert_allclose(geo.normal[-1], 1.0)  # master outward normal points up
+    rng = np.random.default_rng(0)
+    du = 1e-7 * rng.standard_normal(n)
+    fd = pair.geometry(du).gap - geo.gap
+    np.testing.assert_allclose(geo.rows @ du, fd, atol=1e-12)
+    # approach: the top block moving down gives [[v_n]] > 0
+    v = np.zeros(n)
+    v[dim - 1 : top.n_dofs : dim] = -1.0
+    np.testing.assert_allclose(geo.rows @ v, 1.0)
+
+
+def test_point_to_triangle_projection():
+    tet = skfem.MeshTet.init_tensor(np.linspace(0, 1, 3), np.linspace(0, 1, 3), np.array([-1, 0.0]))
+    master = ContactSurface(tet, where=lambda x: x[2] > -1e-9, offset=0)
+    small = (np.array([0.3, 0.4]), np.array([0.6, 0.7]), np.array([0.2, 0.3]))
+    line = skfem.MeshTet.init_tensor(*small)
+    slave = ContactSurface(line, where=lambda x: x[2] < 0.2 + 1e-9, offset=tet.p.size)
+    pair = DeformableContactPair(slave, master, tet.p.size + line.p.size)
+    geo = pair.geometry(np.zeros(tet.p.size + line.p.size))
+    np.testing.assert_allclose(geo.gap, -0.2)  # 0.2 m above the plane z = 0
+    # the master part of each row interpolates (weights sum to 1 on the z components)
+    rows = geo.rows.toarray()
+    np.testing.assert_allclose(rows[:, 2 : tet.p.size : 3].sum(axis=1), 1.0)
+
+
+def _bar_on_wall(n=10, v0=1.0, kappa=None, **kw):
+    bar = LinearElastic(skfem.MeshLine(np.linspace(-1.0, 0.0, n + 1)), STEEL, kind="1d", area=1e-4)
+    system = CoupledSystem([Block("bar", bar, [BlockTerm(bar)])])
+    surf = ContactSurface(bar.mesh, where=lambda x: x[0] > -0.5, area=1e-4)
+    pair = RigidContactPair(surf, PlaneObstacle([0.0], [-1.0]), system.n_dofs)
+    con = LevelSetContact(pair, kappa=kappa, material=STEEL, **kw)
+    return system, con, np.full(bar.n_dofs, v0)
+
+
+def test_levelset_statuses_and_weak_residual():
+    system, con, v0 = _bar_on_wall()
+    c = np.sqrt(210e9 / 7850.0)
+    dt = 0.1 / c
+    res = solve(system, "theta", n_steps=5, dt=dt, v0=v0, constraints=[con], theta=0.5)
+    h = con.history
+    # the end node hits the wall at t = 0: active from the first step, S_d = S_v = 1, λ_v < 0
+    assert h.active[:, 0].all() and h.s_d[:, 0].all() and h.s_v[:, 0].all()
+    assert np.all(h.lam[:, 0] < 0.0)
+    np.testing.assert_allclose(h.vn[:, 0], 0.0, atol=1e-12)
+    assert con.kappa == pytest.approx(np.sqrt(210e9 * 7850.0))
+    # weak λ equation satisfied by the converged step
+    lam = res.multipliers["contact"][-1]
+    np.testing.assert_allclose(con.weak_residual(res.v, lam), 0.0, atol=1e-20)
+    # contact work is the kinetic energy lost (θ = 1/2: exact energy identity)
+    e = res.total_energy
+    assert con.work == pytest.approx(e[-1] - e[0], rel=1e-9)
+
+
+def test_fixed_point_failure_is_reported(caplog):
+    system, con, v0 = _bar_on_wall(max_iterations=1)
+    dt = 0.1 / np.sqrt(210e9 / 7850.0)
+    # force a wrong initial guess: status iterations are needed at the release, cap 1
+    with caplog.at_level(logging.WARNING):
+        res = solve(system, "theta", n_steps=60, dt=dt, v0=v0, constraints=[con], theta=0.5)
+    assert res.n_status_failures >= 1
+    msgs = [r.getMessage() for r in caplog.records]
+    assert any("not converged" in m and "t =" in m for m in msgs)
+    system, con, v0 = _bar_on_wall(max_iterations=1, on_failure="raise")
+    with pytest.raises(ContactConvergenceError, match="not converged"):
+        solve(system, "theta", n_steps=60, dt=dt, v0=v0, constraints=[con], theta=0.5)
+
+
+def test_signorini_baseline_enforces_gap():
+    bar = LinearElastic(skfem.MeshLine(np.linspace(-1.0, 0.0, 11)), STEEL, kind="1d", area=1e-4)
+    system = CoupledSystem([Block("bar", bar, [BlockTerm(bar)])])
+    surf = ContactSurface(bar.mesh, where=lambda x: x[0] > -0.5, area=1e-4)
+    pair = RigidContactPair(surf, PlaneObstacle([0.0], [-1.0]), system.n_dofs)
+    con = SignoriniContact(pair)
+    dt = 0.1 / np.sqrt(210e9 / 7850.0)
+    res = solve(system, "newmark", n_steps=5, dt=dt, v0=np.ones(bar.n_dofs), constraints=[con])
+    h = con.history
+    assert h.active[0, 0]
+    # displacement level: d_n = 0 on active steps, never a penetration (Newmark may chatter)
+    np.testing.assert_allclose(h.gap[h.active[:, 0], 0], 0.0, atol=1e-15)
+    assert np.all(h.gap[:, 0] <= 1e-15)
+    lam = res.multipliers["contact"][1:, 0]
+    assert np.all(lam[h.active[:, 0]] <= 0.0) and np.all(lam[~h.active[:, 0]] == 0.0)
+
+
+def test_invalid_parameters():
+    system, con, _ = _bar_on_wall()
+    with pytest.raises(ValueError, match="kappa"):
+        LevelSetContact(con.pair, kappa=-1.0)
+    with pytest.raises(ValueError, match="eta"):
+        LevelSetContact(con.pair, kappa=1.0, eta=0.0)
+    with pytest.raises(ValueError, match="on_failure"):
+        LevelSetContact(con.pair, kappa=1.0, on_failure="ignore")
+    assert sp.issparse(con.matrix()) and con.matrix().shape == (1, system.n_dofs)
