@@ -97,10 +97,17 @@ class SaddlePoint:
         return out
 
     def best_multipliers(self, u: np.ndarray) -> np.ndarray:
-        """Multipliers minimising ‖[K u + Bᵀλ − f]_free‖ for a given full displacement u."""
-        bt = self.constraints.T.tocsr()[self.free].toarray()
+        """Multipliers minimising ‖[K u + Bᵀλ − f]_free‖ for a given full displacement u.
+
+        Solved through the normal equations (B_f B_fᵀ) λ = B_f r with a sparse LU, then one step
+        of iterative refinement on the least-squares residual.
+        """
+        bt = self.constraints.T.tocsr()[self.free]
         r = (self.load - self.stiffness @ u)[self.free]
-        lam, *_ = np.linalg.lstsq(bt, r, rcond=None)
+        normal = (bt.T @ bt).tocsc()
+        lu = spla.splu(normal)
+        lam = lu.solve(bt.T @ r)
+        lam += lu.solve(bt.T @ (r - bt @ lam))
         return lam
 
 
