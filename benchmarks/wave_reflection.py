@@ -40,11 +40,24 @@ def sweep(widths, ratios, configs, integrators):
             for weights, mediator, coupling in configs:
                 for w in widths:
                     t0 = time.perf_counter()
-                    r = run_wave(ratio=ratio, pulse_width=w, coupling=coupling, mediator=mediator,
-                                 weights=weights, integrator=integrator)
-                    rec = {"integrator": integrator, "ratio": ratio, "weights": weights,
-                           "mediator": mediator, "coupling": coupling, "pulse_width": w,
-                           **r.to_json(), "seconds": time.perf_counter() - t0}
+                    r = run_wave(
+                        ratio=ratio,
+                        pulse_width=w,
+                        coupling=coupling,
+                        mediator=mediator,
+                        weights=weights,
+                        integrator=integrator,
+                    )
+                    rec = {
+                        "integrator": integrator,
+                        "ratio": ratio,
+                        "weights": weights,
+                        "mediator": mediator,
+                        "coupling": coupling,
+                        "pulse_width": w,
+                        **r.to_json(),
+                        "seconds": time.perf_counter() - t0,
+                    }
                     logger.info("%s", rec)
                     out.append(rec)
     return out
@@ -68,15 +81,25 @@ def plot(records, plot_dir: Path) -> list[str]:
                 if k not in keys:
                     keys.append(k)
             for k in keys:
-                rs = [r for r in records if r["integrator"] == integrator and r["ratio"] == ratio
-                      and (r["weights"], r["mediator"], r["coupling"]) == k]
+                rs = [
+                    r
+                    for r in records
+                    if r["integrator"] == integrator
+                    and r["ratio"] == ratio
+                    and (r["weights"], r["mediator"], r["coupling"]) == k
+                ]
                 if not rs:
                     continue
                 rs.sort(key=lambda r: r["pulse_width"])
                 ls = "-" if k[0] == "ramp" else ":"
-                ax.semilogy([r["pulse_width"] for r in rs],
-                            [max(r["reflected_energy_fraction"], 1e-18) for r in rs], ls, marker="o",
-                            ms=3, label=f"{k[0]}, {k[1]} mediator, {k[2]}")
+                ax.semilogy(
+                    [r["pulse_width"] for r in rs],
+                    [max(r["reflected_energy_fraction"], 1e-18) for r in rs],
+                    ls,
+                    marker="o",
+                    ms=3,
+                    label=f"{k[0]}, {k[1]} mediator, {k[2]}",
+                )
             ax.axhline(1e-4, color="k", lw=0.8, ls="--")
             ax.axvline(10, color="grey", lw=0.5)
             ax.axvline(15, color="grey", lw=0.5)
@@ -100,6 +123,7 @@ def main(argv=None) -> int:
     p.add_argument("--plot-dir", default="docs")
     args = p.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s", stream=sys.stderr)
+    logging.getLogger("skfem").setLevel(logging.WARNING)
     widths = [2, 10, 40] if args.quick else WIDTHS
     integrators = ["explicit"] if args.quick else INTEGRATORS
     records = sweep(widths, RATIOS, CONFIGS, integrators)

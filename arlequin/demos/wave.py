@@ -30,17 +30,17 @@ from __future__ import annotations
 import json
 import logging
 import math
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 
 import numpy as np
 import skfem
 
-from ..integrators import CentralDifference, get_integrator, solve
+from ..integrators import DEFAULT_SAFETY, CentralDifference, get_integrator, solve, stable_time_step
 from ..models import IsotropicElastic, LinearElastic
 from ..problem import ArlequinProblem, Patch
 from ..system import Block, BlockTerm, CoupledSystem
 
-__all__ = ["INTEGRATORS", "WaveResult", "run_wave", "wave_layout"]
+__all__ = ["INTEGRATORS", "WaveResult", "plot_wave", "run_wave", "wave_layout"]
 
 logger = logging.getLogger(__name__)
 
@@ -70,11 +70,17 @@ class WaveResult:
     config: dict = field(default_factory=dict)
     multiplier_max: float = 0.0
     coupling_work_max: float = 0.0
+    fields: dict = field(default_factory=dict, repr=False)
 
     def to_json(self) -> dict:
-        keys = ("reflected_energy_fraction", "transmitted_energy_fraction", "energy_drift", "dt", "n_steps")
-        d = asdict(self)
-        return {k: d[k] for k in keys}
+        keys = (
+            "reflected_energy_fraction",
+            "transmitted_energy_fraction",
+            "energy_drift",
+            "dt",
+            "n_steps",
+        )
+        return {k: getattr(self, k) for k in keys}
 
     def dumps(self) -> str:
         return json.dumps(self.to_json(), indent=2)
@@ -91,13 +97,18 @@ class WaveResult:
 
 
 def wave_layout(pulse_width: float, gluing_width: float) -> dict[str, float]:
-    """Positions in coarse elements: a (pulse start), x_patch, band end, length, snapshot distance."""
+    """Positions in coarse elements: a (pulse start), x_patch, band end, length, travel."""
     w, g = float(pulse_width), float(gluing_width)
     a = max(5.0, math.ceil(g))
     x_patch = a + math.ceil(w) + 5.0
     length = x_patch + math.ceil(w) + math.ceil(g) + 15.0
-    return {"a": a, "x_patch": x_patch, "band_end": x_patch + g, "length": length,
-            "travel": w + g + 10.0}
+    return {
+        "a": a,
+        "x_patch": x_patch,
+        "band_end": x_patch + g,
+        "length": length,
+        "travel": w + g + 10.0,
+    }
 
 
 def _pulse(x: np.ndarray, a: float, w: float) -> tuple[np.ndarray, np.ndarray]:
@@ -107,11 +118,20 @@ def _pulse(x: np.ndarray, a: float, w: float) -> tuple[np.ndarray, np.ndarray]:
     return u, du
 
 
-def _region_energy(model: LinearElastic, weight: float, cells: np.ndarray, u: np.ndarray,
-                   v: np.ndarray, lumped: bool) -> float:
+def _region_energy(
+    model: LinearElastic,
+    weight: float,
+    cells: np.ndarray,
+    u: np.ndarray,
+    v: np.ndarray,
+    lumped: bool,
+) -> float:
     """Energy (J) of the given cells of a 1D model (weight constant there)."""
-    sub = LinearElastic(skfem.MeshLine(np.sort(model.mesh.p[0, np.unique(model.mesh.t[:, cells])])),
-                        model.material, area=model.area)
+    sub = LinearElastic(
+        skfem.MeshLine(np.sort(model.mesh.p[0, np.unique(model.mesh.t[:, cells])])),
+        model.material,
+        area=model.area,
+    )
     nodes = np.unique(model.mesh.t[:, cells])
     order = np.argsort(model.mesh.p[0, nodes])
     nodes = nodes[order]
@@ -132,6 +152,7 @@ def run_wave(
     integrator: str = "explicit",
     dt: float | None = None,
     epsilon: float = 1e-3,
+    length: float | None = None,
 ) -> WaveResult:
     """Run the 1D wave demo (see the module docstring).
 
@@ -152,6 +173,9 @@ def run_wave(
         (0.9 × its critical step), for both integrators.
     epsilon : float
         Floor of α_coarse in the patch's free zone.
+    length : float, optional
+        H1 coupling length ℓ in coarse elements; default: the problem's default (the mean
+        coarse cell size on the gluing band, i.e. one coarse element here).
 
     Returns
     -------
@@ -168,16 +192,23 @@ def run_wave(
     name = INTEGRATORS.get(integrator, integrator)
     cls = get_integrator(name)
     lay = wave_layout(pulse_width, gluing_width)
-    n_c = int(round(lay["length"]))
-    n_patch = int(round(lay["length"] - lay["x_patch"]))
+    n_c = round(lay["length"])
+    n_patch = round(lay["length"] - lay["x_patch"])
     mat = IsotropicElastic(YOUNG, 0.0, DENSITY)
     c = math.sqrt(YOUNG / DENSITY)
     coarse_mesh = skfem.MeshLine(np.linspace(0.0, n_c * H, n_c + 1))
     fine_mesh = skfem.MeshLine(np.linspace(lay["x_patch"] * H, n_c * H, n_patch * ratio + 1))
     cm = LinearElastic(coarse_mesh, mat, area=AREA)
     fm = LinearElastic(fine_mesh, mat, area=AREA)
-    patch = Patch(fm, gluing_width=gluing_width * H, weights=weights, coupling=coupling,
-                  mediator=mediator, epsilon=epsilon)
+    patch = Patch(
+        fm,
+        gluing_width=gluing_width * H,
+        weights=weights,
+        coupling=coupling,
+        mediator=mediator,
+        epsilon=epsilon,
+        length=None if length is None else float(length) * H,
+    )
     problem = ArlequinProblem(cm, [patch])
     system = problem.system()
     xc = coarse_mesh.p[0]
@@ -186,17 +217,31 @@ def run_wave(
     v0c = -c * AMPLITUDE * df / H
     u0 = {"coarse": u0c, "patch0": np.zeros(fm.n_dofs)}
     v0 = {"coarse": v0c, "patch0": np.zeros(fm.n_dofs)}
+    stable = stable_time_step(system)
     if dt is None:
-        probe = CentralDifference(system, u0=u0, v0=v0)
-        dt = probe.dt
+        dt = DEFAULT_SAFETY * stable.critical
+    elif dt > stable.critical * (1.0 + 1e-12):
+        raise ValueError(
+            f"time step dt={dt:.6e} s exceeds the critical step of the coupled explicit system, "
+            f"{stable.critical:.6e} s (per-model bound {stable.block_bound:.6e} s)"
+        )
     t_m = lay["travel"] * H / c
-    n_steps = int(math.ceil(t_m / dt))
+    n_steps = math.ceil(t_m / dt)
     lumped = bool(cls.lumped_default)
-    res = solve(system, name, n_steps=n_steps, dt=dt, u0=u0, v0=v0)
+    opts = {"check_dt": False} if issubclass(cls, CentralDifference) else {}
+    res = solve(system, name, n_steps=n_steps, dt=dt, u0=u0, v0=v0, **opts)
     # reference: the coarse model alone, same pulse, integrator and dt
     ref_system = CoupledSystem([Block("coarse", cm, [BlockTerm(cm)])])
-    ref = solve(ref_system, name, n_steps=n_steps, dt=dt, u0={"coarse": u0c}, v0={"coarse": v0c},
-                record_every=n_steps)
+    ref = solve(
+        ref_system,
+        name,
+        n_steps=n_steps,
+        dt=dt,
+        u0={"coarse": u0c},
+        v0={"coarse": v0c},
+        record_every=n_steps,
+        **opts,
+    )
     split = system.split(res.u)
     split_v = system.split(res.v)
     du = split["coarse"] - ref.u
@@ -211,12 +256,33 @@ def run_wave(
     fcent = fine_mesh.p[0, fine_mesh.t].mean(axis=0) / H
     free_f = np.nonzero(fcent > band_end)[0]
     transmitted = _region_energy(cm, epsilon, free_c, split["coarse"], split_v["coarse"], lumped)
-    transmitted += _region_energy(fm, 1.0 - epsilon, free_f, split["patch0"], split_v["patch0"], lumped)
+    transmitted += _region_energy(
+        fm, 1.0 - epsilon, free_f, split["patch0"], split_v["patch0"], lumped
+    )
     mult = [np.max(np.abs(m)) for k, m in res.multipliers.items() if k.startswith("coupling")]
     config = {
-        "ratio": ratio, "pulse_width": pulse_width, "gluing_width": gluing_width,
-        "coupling": coupling, "mediator": mediator, "weights": weights, "integrator": integrator,
-        "epsilon": epsilon, "snapshot_time": n_steps * dt,
+        "ratio": ratio,
+        "pulse_width": pulse_width,
+        "gluing_width": gluing_width,
+        "coupling": coupling,
+        "mediator": mediator,
+        "weights": weights,
+        "integrator": integrator,
+        "epsilon": epsilon,
+        "snapshot_time": n_steps * dt,
+        "length": length,
+    }
+    fields = {
+        "x_coarse": xc,
+        "u_coarse": split["coarse"],
+        "u_reference": ref.u,
+        "u0_coarse": u0c,
+        "x_fine": fine_mesh.p[0],
+        "u_fine": split["patch0"],
+        "x_patch": lay["x_patch"] * H,
+        "band_end": band_end * H,
+        "times": res.times,
+        "energy": res.total_energy,
     }
     out = WaveResult(
         reflected_energy_fraction=reflected / e0,
@@ -228,6 +294,53 @@ def run_wave(
         config=config,
         multiplier_max=float(max(mult)) if mult else 0.0,
         coupling_work_max=float(np.max(np.abs(res.coupling_work["coarse"]))),
+        fields=fields,
     )
     logger.info(out.summary())
     return out
+
+
+def plot_wave(result: WaveResult, path: str) -> None:
+    """PNG of the snapshot: coupled coarse and fine fields, the single-mesh reference, and the
+    reflected wave (their difference in the coarse-only region, magnified)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    f = result.fields
+    fig, (ax1, ax2, ax3) = plt.subplots(3, 1, figsize=(8, 7.5))
+    for ax in (ax1, ax2):
+        ax.axvspan(f["x_patch"], f["band_end"], color="0.9", label="gluing band")
+    ax1.plot(f["x_coarse"], f["u0_coarse"], "k:", lw=1, label="initial pulse")
+    ax1.plot(f["x_coarse"], f["u_reference"], "C2-", lw=1, label="single coarse mesh")
+    ax1.plot(f["x_coarse"], f["u_coarse"], "C0o-", ms=2, lw=1, label="coupled: coarse")
+    ax1.plot(f["x_fine"], f["u_fine"], "C1-", lw=1, label="coupled: fine patch")
+    ax1.set_ylabel("u (m)")
+    ax1.legend(fontsize=7)
+    c = result.config
+    ax1.set_title(
+        f"ratio {c['ratio']}, W = {c['pulse_width']}, G = {c['gluing_width']}, "
+        f"{c['coupling']}, {c['mediator']} mediator, {c['weights']}, {c['integrator']}"
+    )
+    only = f["x_coarse"] <= f["x_patch"] + 1e-12
+    diff = f["u_coarse"] - f["u_reference"]
+    ax2.plot(
+        f["x_coarse"][only],
+        diff[only],
+        "C3o-",
+        ms=2,
+        lw=1,
+        label=f"reflected wave (reflected energy fraction {result.reflected_energy_fraction:.2e})",
+    )
+    ax2.set_ylabel("Δu (m)")
+    ax2.legend(fontsize=7)
+    ax2.set_xlim(ax1.get_xlim())
+    e = f["energy"]
+    ax3.plot(f["times"] * 1e3, e / e[0] - 1.0, "C0-", lw=1)
+    ax3.set_xlabel("t (ms)")
+    ax3.set_ylabel("E(t)/E(0) − 1")
+    ax2.set_xlabel("x (m)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

@@ -62,4 +62,5 @@ __all__ = [
     "register",
     "solve",
     "solve_static",
+    "stable_time_step",
 ]

@@ -155,7 +155,9 @@ class SystemOperators:
             states = []
             for t in b.terms:
                 init = getattr(t.model, "initial_state", None)
-                states.append(init(t.weight) if callable(init) and not _is_linear(t.model) else None)
+                states.append(
+                    init(t.weight) if callable(init) and not _is_linear(t.model) else None
+                )
             out[b.name] = states
         return out
 
@@ -194,7 +196,11 @@ class SystemOperators:
                 ft, new_state = term.model.internal_force(ut, state, term.weight)
                 if tangent:
                     tfun = getattr(term.model, "tangent", None)
-                    kt = tfun(ut, state, term.weight) if callable(tfun) else term.model.stiffness(term.weight)
+                    kt = (
+                        tfun(ut, state, term.weight)
+                        if callable(tfun)
+                        else term.model.stiffness(term.weight)
+                    )
             trial[b.name][ti] = new_state
             p = term.transfer
             fb = ft if p is None else p.T @ ft
@@ -238,7 +244,9 @@ def _as_vector(x: Any, system: CoupledSystem, what: str) -> np.ndarray:
             b = system.block(name)
             val = np.asarray(val, dtype=float).ravel()
             if val.size != b.n_dofs:
-                raise ValueError(f"{what} for block {name!r} has {val.size} values, expected {b.n_dofs}")
+                raise ValueError(
+                    f"{what} for block {name!r} has {val.size} values, expected {b.n_dofs}"
+                )
             out[b.dofs] = val
         return out
     out = np.asarray(x, dtype=float).ravel().copy()
@@ -302,6 +310,14 @@ class EqualityRows:
         self.matrix_cols_t = self.matrix_cols.T.tocsr()
         self.block_of_col = ops.block_of_dof[self.cols]
         self.n_blocks = len(ops.blocks)
+        # per-block row products in one mat-vec: row (b m + i) holds row i of B on block b's dofs
+        if self.m:
+            coo = self.matrix_cols.tocoo()
+            self._stacked = sp.csr_matrix(
+                (coo.data, (self.block_of_col[coo.col] * self.m + coo.row, coo.col)),
+                shape=(self.n_blocks * self.m, self.cols.size),
+            )
+        self._coupling_f = self.coupling.astype(float)
         self._constant = all(not callable(c.rhs) for c in self.constraints)
         self._g0 = self._g(0.0) if self._constant else None
 
@@ -346,10 +362,9 @@ class EqualityRows:
         nb = self.n_blocks
         if self.m == 0:
             return np.zeros(nb), np.zeros(nb)
-        lc = np.where(self.coupling, lam, 0.0)
-        lo = lam - lc
-        pc = -np.bincount(self.block_of_col, self.matrix_cols_t @ lc * x_cols, minlength=nb)
-        po = -np.bincount(self.block_of_col, self.matrix_cols_t @ lo * x_cols, minlength=nb)
+        rb = (self._stacked @ x_cols).reshape(nb, self.m) * lam
+        pc = -(rb * self._coupling_f).sum(axis=1)
+        po = -rb.sum(axis=1) - pc
         return pc, po
 
 
@@ -381,8 +396,13 @@ class ScaledLU:
         Symmetric positive definite: symmetric ordering, diagonal pivots.
     """
 
-    def __init__(self, mat: sp.spmatrix, what: str, names: Callable[[int], str] | None = None,
-                 spd: bool = False) -> None:
+    def __init__(
+        self,
+        mat: sp.spmatrix,
+        what: str,
+        names: Callable[[int], str] | None = None,
+        spd: bool = False,
+    ) -> None:
         mat = sp.csr_matrix(mat)
         n = mat.shape[0]
         diag = np.abs(mat.diagonal())
@@ -429,8 +449,9 @@ class ScaledLU:
         return d * self.lu.solve(np.ascontiguousarray(d * rhs))
 
 
-def _factor_checked(mat: sp.spmatrix, what: str, names: Callable[[int], str] | None = None,
-                    spd: bool = False) -> ScaledLU | None:
+def _factor_checked(
+    mat: sp.spmatrix, what: str, names: Callable[[int], str] | None = None, spd: bool = False
+) -> ScaledLU | None:
     """:class:`ScaledLU` of a square sparse matrix (None if it is empty)."""
     if mat.shape[0] == 0:
         return None
@@ -534,7 +555,10 @@ class DynamicResult:
         """E − E(0) − W_ext − W_c − W_r (J): the numerical energy error, shape (n_rec,)."""
         e = self.total_energy
         return (
-            e - e[0] - self.total_external_work - self.total_coupling_work
+            e
+            - e[0]
+            - self.total_external_work
+            - self.total_coupling_work
             - self.total_constraint_work
         )
 
@@ -542,7 +566,10 @@ class DynamicResult:
         """Energy balance of one block (its coupling work included), shape (n_rec,)."""
         e = self.kinetic[block] + self.strain[block]
         return (
-            e - e[0] - self.external_work[block] - self.coupling_work[block]
+            e
+            - e[0]
+            - self.external_work[block]
+            - self.coupling_work[block]
             - self.constraint_work[block]
         )
 
@@ -555,7 +582,10 @@ class DynamicResult:
 
     def relative_balance(self) -> float:
         """max_t |balance| / max_t(E(t), |W_ext|) (dimensionless)."""
-        scale = max(float(np.max(np.abs(self.total_energy))), float(np.max(np.abs(self.total_external_work))))
+        scale = max(
+            float(np.max(np.abs(self.total_energy))),
+            float(np.max(np.abs(self.total_external_work))),
+        )
         return float(np.max(np.abs(self.balance)) / scale) if scale > 0 else 0.0
 
 
@@ -627,7 +657,9 @@ class Integrator:
         self.system = system
         self.ops = SystemOperators(system, self.lumped_default if lumped is None else lumped)
         all_constraints = list(system.constraints) + list(constraints)
-        self.unilateral: list[UnilateralConstraint] = [c for c in all_constraints if is_unilateral(c)]
+        self.unilateral: list[UnilateralConstraint] = [
+            c for c in all_constraints if is_unilateral(c)
+        ]
         equality = [c for c in all_constraints if not is_unilateral(c)]
         self.rows = EqualityRows(equality, self.ops)
         for c in self.unilateral:
@@ -710,7 +742,9 @@ class Integrator:
             if change > 1e-12 * max(float(np.linalg.norm(old)), 1e-300):
                 logger.info(
                     "initial %s projected onto the constraints (change %.3e, relative %.3e)",
-                    what, change, change / max(float(np.linalg.norm(old)), 1e-300),
+                    what,
+                    change,
+                    change / max(float(np.linalg.norm(old)), 1e-300),
                 )
         return u_new, v_new
 
@@ -726,8 +760,12 @@ class Integrator:
         self._step_impl()
         self.step_count += 1
         if self.check_finite:
+            # Σu² + Σv² (einsum's own loop, no multithreaded BLAS call): NaN, ±inf and values
+            # whose energy would overflow all make it non-finite
             with np.errstate(over="ignore", invalid="ignore"):
-                check = float(np.dot(self.u, self.u) + np.dot(self.v, self.v))
+                check = float(np.einsum("i,i->", self.u, self.u)) + float(
+                    np.einsum("i,i->", self.v, self.v)
+                )
             if not math.isfinite(check):
                 raise SimulationError(
                     f"{self.name}: non-finite displacement or velocity (NaN or overflow) at step "
@@ -767,7 +805,10 @@ class Integrator:
         self.n_status_failures += 1
         logger.warning(
             "%s: unilateral statuses still changing after %d iterations at step %d, t = %.6e s",
-            self.name, self.max_status_iterations, self.step_count + 1, self.t,
+            self.name,
+            self.max_status_iterations,
+            self.step_count + 1,
+            self.t,
         )
 
     # ------------------------------------------------------------------ energies

@@ -78,7 +78,9 @@ class UnilateralConstraint:
         kind: str = "contact",
     ) -> None:
         if level not in ("velocity", "displacement"):
-            raise ValueError(f"constraint level must be 'velocity' or 'displacement', got {level!r}")
+            raise ValueError(
+                f"constraint level must be 'velocity' or 'displacement', got {level!r}"
+            )
         if max_iterations < 1:
             raise ValueError(f"max_iterations must be >= 1, got {max_iterations}")
         self.name = name
@@ -155,13 +157,14 @@ class LinearInequality(UnilateralConstraint):
 
     ``level="displacement"`` (Signorini, primal–dual active set)
         An inactive row becomes active when the predicted end-of-step ``G u − h`` exceeds
-        ``gap_tol``; an active row is released when its multiplier is not positive.
+        ``gap_tol``; an active row is released when its multiplier is negative (tensile).
     ``level="velocity"`` (Moreau)
-        A row is a candidate when its predicted end-of-step gap is closed
-        (``G u − h ≥ −gap_tol``); a candidate is active when it would approach
-        (``G v > 0``, inactive rows) or when its multiplier is positive (active rows); active rows
-        enforce ``G v = 0`` (persistent contact), so the penetration is at most of the order of
-        Δt times the approach velocity at activation and does not drift afterwards.
+        A row is a candidate when its end-of-step gap predicted with the step's free velocity
+        (passed to :meth:`begin_step`) is closed (``G (u + Δt v) − h ≥ −gap_tol``); a
+        candidate is active when it would approach (``G v > 0``, inactive rows) or when its
+        multiplier is not negative (active rows); active rows enforce ``G v = 0`` (persistent
+        contact), so the penetration is at most of the order of Δt times the approach velocity
+        at activation and does not drift afterwards.
 
     Parameters
     ----------
@@ -204,14 +207,13 @@ class LinearInequality(UnilateralConstraint):
 
     def update_status(self, u: np.ndarray, v: np.ndarray, multipliers: np.ndarray) -> bool:
         old = self.active.copy()
-        gap = self._g @ u - self._pending_bound
         lam = np.asarray(multipliers, dtype=float)
         if self.level == "displacement":
-            new = np.where(old, lam > 0.0, gap > self.gap_tol)
+            gap = self._g @ u - self._pending_bound
+            new = np.where(old, lam >= 0.0, gap > self.gap_tol)
         else:
-            closed = gap >= -self.gap_tol
             approach = self._g @ v > 0.0
-            new = closed & np.where(old, lam > 0.0, approach)
+            new = self._closed & np.where(old, lam >= 0.0, approach)
         self.active = new
         return bool(np.any(new != old))
 
@@ -219,6 +221,6 @@ class LinearInequality(UnilateralConstraint):
         # the bound at the end of the step, used by update_status
         self._pending_bound = self.bound(t + dt)
         if self.level == "velocity":
-            # rows whose predicted gap is open cannot stay active
-            free_flight = self._g @ (u + dt * v) - self._pending_bound < -self.gap_tol
-            self.active = self.active & ~free_flight
+            # S_d: the gap predicted with the step's free velocity, fixed during the iterations
+            self._closed = self._g @ (u + dt * v) - self._pending_bound >= -self.gap_tol
+            self.active = self.active & self._closed

@@ -31,6 +31,7 @@ triangular solve pair.
 from __future__ import annotations
 
 import logging
+import time
 from typing import Any
 
 import numpy as np
@@ -94,7 +95,10 @@ class _ImpulseSolver:
         if self.m_e == 0:
             fac = self._cache.get(key)
             if fac is None:
-                fac = ("lu", _factor_checked(s_aa, "the impulse matrix of the active rows", spd=True))
+                fac = (
+                    "lu",
+                    _factor_checked(s_aa, "the impulse matrix of the active rows", spd=True),
+                )
                 self._cache = {key: fac}
             return np.zeros(0), fac[1].solve(r_a)
         s_ae = (g_a @ sp.diags(minv) @ self.rows.matrix.T).tocsr()
@@ -119,7 +123,10 @@ class _ImpulseSolver:
         fac = self._cache.get(key)
         if fac is None:
             full = sp.bmat([[self.s_ee, s_ae.T], [s_ae, s_aa]], format="csc")
-            fac = ("full", _factor_checked(full, "the impulse matrix with the active rows", spd=True))
+            fac = (
+                "full",
+                _factor_checked(full, "the impulse matrix with the active rows", spd=True),
+            )
             self._cache = {key: fac}
         sol = fac[1].solve(np.concatenate([r_e, r_a]))
         return sol[: self.m_e], sol[self.m_e :]
@@ -172,12 +179,17 @@ class CentralDifference(Integrator):
         self.check_dt = bool(check_dt)
         self.stable_step: StableStep | None = None
         self._solver: _ImpulseSolver | None = None
+        #: wall time (s) spent in the constraint impulses (transfers B v, Bᵀ Λ and the solve)
+        self.constraint_time = 0.0
         super().__init__(system, dt, **kwargs)
 
     # ------------------------------------------------------------------ set-up
     def _impulse_solver(self) -> _ImpulseSolver:
         if self._solver is None:
             self._solver = _ImpulseSolver(self.rows, self.ops.inv_mass)
+            self._minv_cols = self.ops.inv_mass[self.rows.cols]
+            self._no_rows = sp.csr_matrix((0, self.ops.n))
+            self._no_lam = np.zeros(0)
         return self._solver
 
     def _choose_dt(self, dt: float | None) -> float:
@@ -200,61 +212,73 @@ class CentralDifference(Integrator):
         return dt
 
     # ------------------------------------------------------------------ helpers
-    def _targets(self, t_next: float, u: np.ndarray) -> np.ndarray:
-        """Velocity targets w of the equality rows for the mid-step velocity ending at t_next."""
+    def _rhs_equality(self, v_star: np.ndarray, u: np.ndarray, t_next: float) -> np.ndarray:
+        """B v* − w for the equality rows, w the velocity targets of the mid-step velocity
+        ending at t_next: (g(t_next) − B u)/Δt (displacement rows), g(t_next − Δt/2) (velocity
+        rows)."""
         rows = self.rows
-        if rows.m == 0:
-            return np.zeros(0)
         dt = self.dt
-        bu = rows.matrix_cols @ u[rows.cols]
-        w = np.empty(rows.m)
+        cols = rows.cols
+        if rows.displacement.all():
+            # B v* − (g − B u)/Δt = B (v* + u/Δt) − g/Δt: one product on the touched dofs
+            return rows.matrix_cols @ (v_star[cols] + u[cols] / dt) - rows.g(t_next) / dt
         disp = rows.displacement
-        if rows.time_dependent:
-            w[disp] = (rows.g(t_next)[disp] - bu[disp]) / dt
-            w[~disp] = rows.g(t_next - 0.5 * dt)[~disp]
-        else:
-            g = rows.g(t_next)
-            w[disp] = (g[disp] - bu[disp]) / dt
-            w[~disp] = g[~disp]
-        return w
+        bv = rows.matrix_cols @ v_star[cols]
+        bu = rows.matrix_cols @ u[cols]
+        g_end = rows.g(t_next)
+        g_mid = rows.g(t_next - 0.5 * dt) if rows.time_dependent else g_end
+        return bv - np.where(disp, (g_end - bu) / dt, g_mid)
 
     def _impulse(
         self, v_star: np.ndarray, u: np.ndarray, t: float, scale: float
     ) -> tuple[np.ndarray, np.ndarray, list[np.ndarray], sp.csr_matrix, np.ndarray]:
         """Impulses making ``v_star − scale·M⁻¹BᵀΛ`` satisfy the rows for the step from t.
 
-        ``scale`` is 1 for a full step and 1/2 for the initial half step. Returns (Λ_E,
-        Λ_A, [full unilateral multipliers per constraint, as forces], G_A, v_new).
+        ``scale`` is 1 for a full step and 1/2 for the initial half step. ``v_star`` is
+        overwritten. Returns (Λ_E, Λ_A, [full unilateral multipliers per constraint, as
+        forces], G_A, v_new).
         """
         rows = self.rows
         dt = self.dt
         solver = self._impulse_solver()
         t_next = t + dt
-        r_e = (rows.matrix_cols @ v_star[rows.cols] - self._targets(t_next, u)) / scale if rows.m else np.zeros(0)
+        r_e = self._rhs_equality(v_star, u, t_next) / scale if rows.m else np.zeros(0)
         minv = self.ops.inv_mass
         if not self.unilateral:
             lam_e = solver.solve_equality(r_e)
-            v_new = v_star.copy()
+            v_new = v_star
             if rows.m:
-                v_new[rows.cols] -= scale * minv[rows.cols] * (rows.matrix_cols_t @ lam_e)
+                v_new[rows.cols] -= (scale * self._minv_cols) * (rows.matrix_cols_t @ lam_e)
             self.status_iterations = 0
-            return lam_e, np.zeros(0), [], sp.csr_matrix((0, self.ops.n)), v_new
+            return lam_e, self._no_lam, [], self._no_rows, v_new
         for c in self.unilateral:
             c.begin_step(t, dt, u, v_star)
         converged = False
-        for it in range(1, self.max_status_iterations + 1):
+        it = 0
+        while it < self.max_status_iterations:
+            it += 1
             g_a, idx = self._active_rows()
-            rhs_a = np.concatenate(
-                [c.rhs(t_next)[a] for c, a in zip(self.unilateral, idx)]
-            ) if idx else np.zeros(0)
-            lev_disp = np.concatenate(
-                [np.full(a.size, c.level == "displacement") for c, a in zip(self.unilateral, idx)]
-            ) if idx else np.zeros(0, dtype=bool)
+            v_trial = v_star.copy()
+            rhs_a = (
+                np.concatenate([c.rhs(t_next)[a] for c, a in zip(self.unilateral, idx)])
+                if idx
+                else np.zeros(0)
+            )
+            lev_disp = (
+                np.concatenate(
+                    [
+                        np.full(a.size, c.level == "displacement")
+                        for c, a in zip(self.unilateral, idx)
+                    ]
+                )
+                if idx
+                else np.zeros(0, dtype=bool)
+            )
             w_a = np.where(lev_disp, (rhs_a - g_a @ u) / dt, rhs_a)
-            r_a = (g_a @ v_star - w_a) / scale
+            r_a = (g_a @ v_trial - w_a) / scale
             key = tuple(a.tobytes() for a in idx) + tuple(id(c.matrix()) for c in self.unilateral)
             lam_e, lam_a = solver.solve(r_e, g_a, r_a, key)
-            v_new = v_star.copy()
+            v_new = v_trial
             if rows.m:
                 v_new[rows.cols] -= scale * minv[rows.cols] * (rows.matrix_cols_t @ lam_e)
             if g_a.shape[0]:
@@ -266,14 +290,16 @@ class CentralDifference(Integrator):
                 break
         self.status_iterations = it
         if not converged:
+            # the step keeps the last solve; the statuses were updated after it and are the
+            # next step's starting guess
             self._status_cap_reached()
-            # keep the last solve (the statuses were updated after it: re-solve with them would
-            # need another iteration), so return the statuses it was computed with
         return lam_e, lam_a, fulls, g_a, v_new
 
     def _forces(self, u: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray, dict]:
         f_int, trial, _ = self.ops.internal_force(u, self.states)
         f_ext = self.system.external_force(t) if self.system.load is not None else None
+        if f_ext is not None and not f_ext.any():
+            f_ext = None  # unloaded at t: skip the force and its power
         return f_int, f_ext, trial
 
     def _record_impulse(self, lam_e, fulls, g_a, lam_a) -> None:
@@ -328,7 +354,9 @@ class CentralDifference(Integrator):
         a = -minv * f_int if f_ext is None else minv * (f_ext - f_int)
         # impulse at t_{n+1} for the next mid-step velocity
         v_star = v_half + dt * a
+        tic = time.perf_counter()
         lam_e, lam_a, fulls, g_a, v_next = self._impulse(v_star, u, self.t, 1.0)
+        self.constraint_time += time.perf_counter() - tic
         self.states = trial
         self.u = u
         self.a = a

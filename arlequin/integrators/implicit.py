@@ -22,7 +22,8 @@ HHT-α          a^{n+1}      ũ, βΔt²                     γΔt          (1+�
 =============  ===========  ==========================  ===========  ==========  ==========
 
 (ũ = u^n + Δt v^n + (½−β)Δt² a^n; HHT: α ∈ [−1/3, 0], β = (1−α)²/4, γ = ½ − α; θ-scheme:
-u^{n+1} = u^n + Δt((1−θ)v^n + θ v^{n+1}), M(v^{n+1} − v^n)/Δt = f̄ − w₁f_int^{n+1} − w₀f_int^n − Bᵀλ).
+u^{n+1} = u^n + Δt((1−θ)v^n + θ v^{n+1}),
+M(v^{n+1} − v^n)/Δt = f̄ − w₁f_int^{n+1} − w₀f_int^n − Bᵀλ).
 
 Linear models: the matrix [[c_a M + w₁ c_u K, Bᵀ], [B, 0]] is factorised once (SuperLU) and each
 step is one solve; nonlinear models: Newton iterations on R with the consistent tangent. The
@@ -40,7 +41,7 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from .base import Integrator, SimulationError, _factor_checked, register
+from .base import Integrator, SimulationError, _factor_checked, register, unilateral_block_power
 from .stability import stable_time_step
 
 __all__ = ["HHTAlpha", "ImplicitIntegrator", "Newmark", "ThetaScheme"]
@@ -118,7 +119,8 @@ class ImplicitIntegrator(Integrator):
 
     def _initialize(self) -> None:
         self._lu_cache = {}
-        f_int, trial, kt = self.ops.internal_force(self.u, self.states)
+        self._empty_rows = sp.csr_matrix((0, self.ops.n))
+        f_int, trial, _kt = self.ops.internal_force(self.u, self.states)
         self.states = trial
         self._f_int = f_int
         self._f_ext = self._external(self.t)
@@ -147,7 +149,11 @@ class ImplicitIntegrator(Integrator):
             sol = lu.solve(np.concatenate([r, target]))
             a, lam = sol[: self.ops.n], sol[self.ops.n :]
         else:
-            a = r / m if self.ops.lumped else _factor_checked(sp.csc_matrix(m), "the mass", spd=True).solve(r)
+            a = (
+                r / m
+                if self.ops.lumped
+                else _factor_checked(sp.csc_matrix(m), "the mass", spd=True).solve(r)
+            )
             lam = np.zeros(0)
         self.a = a
         self._lam = lam
@@ -155,7 +161,8 @@ class ImplicitIntegrator(Integrator):
         for c in self.unilateral:
             self.multipliers[c.name] = np.zeros(c.n_rows)
         self._fc_old = rows.matrix.T @ lam if rows.m else np.zeros(self.ops.n)
-        self._old_rows = None
+        self._lam_e_old = lam
+        self._uni_old = [np.zeros(c.n_rows) for c in self.unilateral]
 
     # ------------------------------------------------------------------ linear algebra
     def _mass_times(self, x: np.ndarray) -> np.ndarray:
@@ -171,6 +178,14 @@ class ImplicitIntegrator(Integrator):
     ) -> tuple[sp.csr_matrix, np.ndarray, list[np.ndarray], Any]:
         """Equality + active unilateral rows written on x: (B, r, active index lists, key)."""
         rows = self.rows
+        if not self.unilateral:
+            if not rows.m:
+                return self._empty_rows, np.zeros(0), [], ()
+            g = rows.g(t_new)
+            rhs_e = np.where(
+                rows.displacement, (g - rows.matrix @ u_p) / c_u, (g - rows.matrix @ v_p) / c_v
+            )
+            return rows.matrix, rhs_e, [], ()
         mats, rhs = [], []
         if rows.m:
             g = rows.g(t_new)
@@ -206,7 +221,9 @@ class ImplicitIntegrator(Integrator):
             lu = self._lu_cache.get(key)
             if lu is None:
                 mat = self._system_matrix(self.ops.stiffness, c_a, c_u, b)
-                lu = _factor_checked(mat, f"the {self.name} saddle point [[c_a M + c_u K, Bᵀ], [B, 0]]")
+                lu = _factor_checked(
+                    mat, f"the {self.name} saddle point [[c_a M + c_u K, Bᵀ], [B, 0]]"
+                )
                 if len(self._lu_cache) >= 8:
                     self._lu_cache.clear()
                 self._lu_cache[key] = lu
@@ -217,23 +234,23 @@ class ImplicitIntegrator(Integrator):
             f_int, trial, _ = self.ops.internal_force(u, self.states)
             self.newton_iterations = 1
             return x, mu, b, idx, f_int, trial
-        # Newton
+        # Newton: one internal-force + tangent evaluation per iteration
         x = self._x_from_state()
         mu = np.zeros(b.shape[0])
         scale0 = max(float(np.linalg.norm(known)), 1e-300)
+        f_int, trial, kt = self.ops.internal_force(u_p + c_u * x, self.states, tangent=True)
+        res = np.full(n, np.inf)
         for it in range(1, self.max_newton + 1):
-            u = u_p + c_u * x
-            f_int, trial, kt = self.ops.internal_force(u, self.states, tangent=True)
-            res = self._mass_times(c_a * x) + self.w1 * f_int - known
+            res0 = self._mass_times(c_a * x) + self.w1 * f_int - known
             mat = self._system_matrix(kt, c_a, c_u, b)
             lu = _factor_checked(mat, f"the {self.name} Newton saddle point")
-            sol = lu.solve(np.concatenate([-res, r_rows - b @ x]))
+            sol = lu.solve(np.concatenate([-res0, r_rows - b @ x]))
             dx, mu = sol[:n], sol[n:]
             x = x + dx
-            u = u_p + c_u * x
-            f_int, trial, _ = self.ops.internal_force(u, self.states)
-            res = self._mass_times(c_a * x) + self.w1 * f_int - known + b.T @ mu
-            scale = max(scale0, float(np.linalg.norm(self.w1 * f_int)), float(np.linalg.norm(b.T @ mu)))
+            f_int, trial, kt = self.ops.internal_force(u_p + c_u * x, self.states, tangent=True)
+            bmu = b.T @ mu if b.shape[0] else 0.0
+            res = self._mass_times(c_a * x) + self.w1 * f_int - known + bmu
+            scale = max(scale0, float(np.linalg.norm(self.w1 * f_int)), float(np.linalg.norm(bmu)))
             if np.linalg.norm(res) <= self.newton_rtol * scale + self.newton_atol:
                 self.newton_iterations = it
                 return x, mu, b, idx, f_int, trial
@@ -254,7 +271,9 @@ class ImplicitIntegrator(Integrator):
         for c in self.unilateral:
             c.begin_step(self.t, dt, self.u, self.v)
         converged = False
-        for it in range(1, self.max_status_iterations + 1):
+        it = 0
+        while it < self.max_status_iterations:
+            it += 1
             x, mu, b, idx, f_int, trial = self._solve_constrained(t_new)
             u_p, c_u, v_p, c_v, _, _ = self._affine()
             u_new = u_p + c_u * x
@@ -268,19 +287,29 @@ class ImplicitIntegrator(Integrator):
         self.status_iterations = it if self.unilateral else 0
         if not converged:
             self._status_cap_reached()
-        # works with the forces of the step
+        # works with the forces of the step: −Δu·Bᵀλ̄ per block (λ̄: mean of the end-point
+        # multipliers, or the step multipliers of the θ-scheme)
         du = u_new - self.u
         nb = len(self.ops.blocks)
-        fc_new = b.T @ lam_all if b.shape[0] else np.zeros(self.ops.n)
+        rows = self.rows
+        m_e = rows.m
+        lam_e_new = lam_all[:m_e]
         if self.endpoint_multipliers:
             f_ext_w = 0.5 * (self._f_ext + self._f_ext_new)
-            w_c, w_o = self._constraint_works(b, lam_all, du, half=True)
-            w_c_old, w_o_old = self._old_constraint_works(du)
-            w_c, w_o = w_c + w_c_old, w_o + w_o_old
+            lam_e_w = 0.5 * (self._lam_e_old + lam_e_new)
+            uni_w = [0.5 * (o + n) for o, n in zip(self._uni_old, fulls)]
         else:
             f_ext_w = self.w1 * self._f_ext_new + self.w0 * self._f_ext
-            w_c, w_o = self._constraint_works(b, lam_all, du, half=False)
-        self._w_ext += self.ops.block_dots(du, f_ext_w) if self.system.load is not None else np.zeros(nb)
+            lam_e_w = lam_e_new
+            uni_w = fulls
+        if m_e:
+            w_c, w_o = rows.block_powers(lam_e_w, du[rows.cols])
+        else:
+            w_c, w_o = np.zeros(nb), np.zeros(nb)
+        for c, lam in zip(self.unilateral, uni_w):
+            w_o = w_o + unilateral_block_power(self.ops, c.matrix(), lam, du)
+        if self.system.load is not None:
+            self._w_ext += self.ops.block_dots(du, f_ext_w)
         self._w_coupling += w_c
         self._w_constraint += w_o
         if not self.ops.linear:
@@ -293,9 +322,11 @@ class ImplicitIntegrator(Integrator):
         self.states = trial
         self._f_int = f_int
         self._f_ext = self._f_ext_new
-        self._fc_old = fc_new
-        self._old_rows = (b, lam_all)
-        mult = self.rows.split(lam_all[: self.rows.m]) if self.rows.m else {}
+        if self.w0c:
+            self._fc_old = b.T @ lam_all if b.shape[0] else np.zeros(self.ops.n)
+        self._lam_e_old = lam_e_new
+        self._uni_old = fulls
+        mult = rows.split(lam_e_new) if m_e else {}
         for c, lam in zip(self.unilateral, fulls):
             mult[c.name] = lam
             c.end_step(self.t, self.u, self.v, lam)
@@ -304,30 +335,6 @@ class ImplicitIntegrator(Integrator):
     def _multipliers_from(self, mu: np.ndarray) -> np.ndarray:
         """Reported multipliers (N) from the unknown μ."""
         return mu / self.w1 if self.endpoint_multipliers else mu
-
-    def _constraint_works(self, b, lam, du, half: bool) -> tuple[np.ndarray, np.ndarray]:
-        """−(Bᵀλ)·Δu per block for coupling rows and the other rows (× ½ if ``half``)."""
-        nb = len(self.ops.blocks)
-        if b.shape[0] == 0:
-            return np.zeros(nb), np.zeros(nb)
-        k = 0.5 if half else 1.0
-        m_e = self.rows.m
-        lam_c = np.zeros(b.shape[0])
-        lam_c[:m_e] = np.where(self.rows.coupling, lam[:m_e], 0.0)
-        lam_o = lam - lam_c
-        w_c = -k * self.ops.block_dots(b.T @ lam_c, du)
-        w_o = -k * self.ops.block_dots(b.T @ lam_o, du)
-        return w_c, w_o
-
-    def _old_constraint_works(self, du: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        old = self._old_rows
-        if old is None:
-            # first step: the initial multipliers of the equality rows
-            b = self.rows.matrix
-            lam = self._lam if self.rows.m else np.zeros(0)
-            return self._constraint_works(b, lam, du, half=True)
-        b, lam = old
-        return self._constraint_works(b, lam, du, half=True)
 
 
 @register("newmark")
@@ -344,8 +351,15 @@ class Newmark(ImplicitIntegrator):
 
     name = "newmark"
 
-    def __init__(self, system, dt: float | None = None, *, beta: float = 0.25, gamma: float = 0.5,
-                 **kwargs: Any) -> None:
+    def __init__(
+        self,
+        system,
+        dt: float | None = None,
+        *,
+        beta: float = 0.25,
+        gamma: float = 0.5,
+        **kwargs: Any,
+    ) -> None:
         if not beta > 0.0:
             raise ValueError(f"Newmark beta must be positive (implicit), got beta={beta}")
         if not gamma >= 0.5:
@@ -380,8 +394,16 @@ class HHTAlpha(Newmark):
 
     name = "hht"
 
-    def __init__(self, system, dt: float | None = None, *, alpha: float = -0.1,
-                 beta: float | None = None, gamma: float | None = None, **kwargs: Any) -> None:
+    def __init__(
+        self,
+        system,
+        dt: float | None = None,
+        *,
+        alpha: float = -0.1,
+        beta: float | None = None,
+        gamma: float | None = None,
+        **kwargs: Any,
+    ) -> None:
         if not -1.0 / 3.0 - 1e-12 <= alpha <= 0.0:
             raise ValueError(f"HHT alpha must lie in [-1/3, 0], got alpha={alpha}")
         self.alpha = float(alpha)
@@ -410,7 +432,9 @@ class ThetaScheme(ImplicitIntegrator):
     name = "theta"
     endpoint_multipliers = False
 
-    def __init__(self, system, dt: float | None = None, *, theta: float = 0.5, **kwargs: Any) -> None:
+    def __init__(
+        self, system, dt: float | None = None, *, theta: float = 0.5, **kwargs: Any
+    ) -> None:
         if not 0.5 <= theta <= 1.0:
             raise ValueError(f"theta must lie in [1/2, 1], got theta={theta}")
         self.theta = float(theta)
@@ -439,3 +463,5 @@ class ThetaScheme(ImplicitIntegrator):
         # the θ-scheme needs no initial acceleration; multipliers are step quantities
         self.a = np.zeros(self.ops.n)
         self._lam = np.zeros(self.rows.m)
+        self._lam_e_old = self._lam
+        self._uni_old = [np.zeros(c.n_rows) for c in self.unilateral]

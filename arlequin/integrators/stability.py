@@ -42,7 +42,7 @@ __all__ = ["StableStep", "largest_eigenvalue", "stable_time_step"]
 
 logger = logging.getLogger(__name__)
 
-_DENSE_LIMIT = 600
+_DENSE_LIMIT = 200
 
 
 @dataclass(frozen=True)
@@ -79,18 +79,28 @@ def largest_eigenvalue(op, n: int, tol: float = 1e-10, dense=None) -> float:
     tol : float
         Relative tolerance of the Lanczos iterations.
     dense : callable, optional
-        Returns the dense matrix (used instead of Lanczos for n <= 600).
+        Returns the dense matrix (used instead of Lanczos for n <= 200).
     """
     if n == 0:
         return 0.0
     if n <= _DENSE_LIMIT:
-        mat = dense() if dense is not None else (op.toarray() if sp.issparse(op) else op @ np.eye(n))
+        mat = (
+            dense() if dense is not None else (op.toarray() if sp.issparse(op) else op @ np.eye(n))
+        )
         mat = 0.5 * (mat + mat.T)
         return float(sla.eigvalsh(mat, subset_by_index=[n - 1, n - 1])[0])
     rng = np.random.default_rng(12345)
     v0 = rng.standard_normal(n)
-    vals = spla.eigsh(op, k=1, which="LA", tol=tol, v0=v0, ncv=min(n, 40), maxiter=50 * n,
-                      return_eigenvectors=False)
+    vals = spla.eigsh(
+        op,
+        k=1,
+        which="LA",
+        tol=tol,
+        v0=v0,
+        ncv=min(n, 40),
+        maxiter=50 * n,
+        return_eigenvectors=False,
+    )
     return float(vals[0])
 
 
@@ -178,6 +188,9 @@ def stable_time_step(
         "critical time step (%s): %.6e s (per-model bound %.6e s)", method, crit, block_bound
     )
     return StableStep(
-        critical=crit, block_bound=block_bound, per_block=per_block,
-        omega_max=math.sqrt(max(lam, 0.0)), method=method,
+        critical=crit,
+        block_bound=block_bound,
+        per_block=per_block,
+        omega_max=math.sqrt(max(lam, 0.0)),
+        method=method,
     )
