@@ -89,19 +89,32 @@ def _add_two_bars(sub) -> None:
     )
     p.add_argument("--method", choices=["levelset", "newmark", "both"], default="levelset")
     p.add_argument("--newmark", choices=["trapezoidal", "hht"], default="trapezoidal")
-    p.add_argument("--lengths", nargs=2, type=float, default=[1.0, 1.0], metavar=("L1", "L2"),
-                   help="bar lengths (m)")
+    p.add_argument(
+        "--lengths",
+        nargs=2,
+        type=float,
+        default=[1.0, 1.0],
+        metavar=("L1", "L2"),
+        help="bar lengths (m)",
+    )
     p.add_argument("--young", type=float, default=210e9, metavar="E", help="Young's modulus (Pa)")
     p.add_argument("--density", type=float, default=7850.0, metavar="RHO", help="density (kg/m^3)")
     p.add_argument("--velocity", type=float, default=1.0, metavar="V0", help="bar 1 velocity (m/s)")
-    p.add_argument("--velocity2", type=float, default=0.0, metavar="V2",
-                   help="bar 2 velocity (m/s)")
+    p.add_argument(
+        "--velocity2", type=float, default=0.0, metavar="V2", help="bar 2 velocity (m/s)"
+    )
     p.add_argument("--elements", type=int, default=100, metavar="N", help="elements per bar")
     p.add_argument("--cfl", type=float, default=1.0, metavar="C", help="dt = C h_min / c")
-    p.add_argument("--theta", type=float, default=0.5, metavar="T",
-                   help="theta of the theta-scheme")
-    p.add_argument("--t-end", type=float, default=None, metavar="T",
-                   help="end time (s), default 3 max(L1, L2)/c")
+    p.add_argument(
+        "--theta", type=float, default=0.5, metavar="T", help="theta of the theta-scheme"
+    )
+    p.add_argument(
+        "--t-end",
+        type=float,
+        default=None,
+        metavar="T",
+        help="end time (s), default 3 max(L1, L2)/c",
+    )
     p.add_argument("--json", metavar="PATH", default=None, help="write the histories as JSON")
     p.add_argument("--plot", metavar="PNG", default=None, help="plot against the exact solution")
     p.set_defaults(func=_cmd_two_bars)
