@@ -113,7 +113,7 @@ def coupling_matrices(
     length: float | None = None,
     mediator: str = "coarse",
     axisymmetric: bool = False,
-    intorder: int = 3,
+    intorder: int | None = None,
 ) -> CouplingMatrices:
     """Assemble C_coarse and C_fine on the gluing cells of an overlap.
 
@@ -139,6 +139,9 @@ def coupling_matrices(
     """
     if mediator not in ("coarse", "fine"):
         raise ValueError(f"mediator must be 'coarse' or 'fine', got {mediator!r}")
+    if intorder is None:
+        # products of two first-order functions (times r in axisymmetry) are integrated exactly
+        intorder = 3 if axisymmetric else 2
     gram = gram_matrix(
         overlap, gluing_cells, n_components, coupling, length or 0.0, axisymmetric, intorder
     )

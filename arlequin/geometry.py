@@ -1,13 +1,14 @@
 """Boundary geometry: boundary facets as coordinates, and distances from points to facet sets.
 
-Distances are exact (to round-off) for the faceted geometry: 1D by sorted search, 2D by shapely's
-STRtree nearest-segment query, 3D by trimesh's closest-point query on the triangulated facets.
+Distances are exact (to round-off) for the faceted geometry: 1D by sorted search, 2D and 3D by
+vectorised point-to-segment / point-to-triangle distances on KD-tree candidates (bounded memory).
 Points are given in scikit-fem's convention, shape (dim, n_points), in m.
 """
 
 from __future__ import annotations
 
 import numpy as np
+from scipy.spatial import cKDTree
 from skfem import Mesh, MeshHex, MeshQuad
 
 __all__ = ["boundary_distance", "distance_to_facets", "facet_coordinates"]
@@ -42,14 +43,54 @@ def _cyclic_quad_faces(p: np.ndarray, f: np.ndarray) -> np.ndarray:
     return np.take_along_axis(f, order, axis=0)
 
 
-def distance_to_facets(points: np.ndarray, facets: np.ndarray) -> np.ndarray:
+def _segment_distance(x: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Distance from x to segments [a, b]; arrays (..., dim) broadcast together."""
+    ab = b - a
+    t = np.einsum("...d,...d->...", x - a, ab) / np.einsum("...d,...d->...", ab, ab)
+    t = np.clip(t, 0.0, 1.0)
+    return np.linalg.norm(x - a - t[..., None] * ab, axis=-1)
+
+
+def _triangle_distance(x: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """Distance from x to triangles (a, b, c); arrays (..., 3) broadcast together."""
+    n = np.cross(b - a, c - a)
+    nn = np.einsum("...d,...d->...", n, n)
+    s = np.einsum("...d,...d->...", x - a, n) / nn
+    y = x - s[..., None] * n  # projection onto the triangle's plane
+
+    def signed(p, q, r):
+        return np.einsum("...d,...d->...", np.cross(q - p, r - p), n)
+
+    inside = (signed(y, b, c) >= 0) & (signed(a, y, c) >= 0) & (signed(a, b, y) >= 0)
+    edges = np.minimum(
+        np.minimum(_segment_distance(x, a, b), _segment_distance(x, b, c)),
+        _segment_distance(x, c, a),
+    )
+    return np.where(inside, np.abs(s) * np.sqrt(nn), edges)
+
+
+def distance_to_facets(
+    points: np.ndarray,
+    facets: np.ndarray,
+    cap: float | None = None,
+    chunk_size: int = 20_000,
+) -> np.ndarray:
     """Euclidean distance from each point to the nearest facet.
+
+    Candidates come from a KD-tree over the facet centroids, nearest first, and grow by 4 until
+    the distance found is provably the minimum: every facet not yet tested has its centroid at
+    least ρ_k away (ρ_k the k-th candidate's centroid distance), hence lies at least ρ_k − R away
+    (R the largest centroid-to-vertex distance). Memory is bounded by ``chunk_size`` × k.
 
     Parameters
     ----------
     points : ndarray, shape (dim, n_points)
     facets : ndarray, shape (n_facets, n_vertices_per_facet, dim)
-        Points (1D), segments (2D), triangles or quadrilaterals (3D).
+        Points (1D), segments (2D), triangles or quadrilaterals (3D; split into two triangles).
+    cap : float, optional
+        Distances are exact where they are ≤ ``cap``; beyond it the returned value is only a
+        lower bound that exceeds ``cap`` (enough for weights that saturate at a band width, and
+        much cheaper for points far from the facets). Default: exact everywhere.
 
     Returns
     -------
@@ -68,27 +109,41 @@ def distance_to_facets(points: np.ndarray, facets: np.ndarray) -> np.ndarray:
         lo = xs[np.clip(idx - 1, 0, len(xs) - 1)]
         hi = xs[np.clip(idx, 0, len(xs) - 1)]
         return np.minimum(np.abs(points[0] - lo), np.abs(points[0] - hi))
-    if dim == 2:
-        import shapely
-
-        segments = shapely.linestrings(facets)
-        tree = shapely.STRtree(segments)
-        pts = shapely.points(points.T)
-        (ip, _), dist = tree.query_nearest(pts, return_distance=True, all_matches=False)
-        out = np.full(n, np.inf)
-        out[ip] = dist
-        return out
-    import trimesh
-
-    if facets.shape[1] == 4:
-        tri = np.concatenate([facets[:, [0, 1, 2]], facets[:, [0, 2, 3]]], axis=0)
-    else:
-        tri = facets
-    vertices = tri.reshape(-1, 3)
-    faces = np.arange(vertices.shape[0]).reshape(-1, 3)
-    surface = trimesh.Trimesh(vertices=vertices, faces=faces, process=False)
-    _, dist, _ = trimesh.proximity.closest_point(surface, points.T)
-    return np.asarray(dist, dtype=float)
+    if dim == 3 and facets.shape[1] == 4:
+        facets = np.concatenate([facets[:, [0, 1, 2]], facets[:, [0, 2, 3]]], axis=0)
+    cap = np.inf if cap is None else float(cap)
+    x = np.ascontiguousarray(points.T)
+    centroids = facets.mean(axis=1)
+    radius = float(np.linalg.norm(facets - centroids[:, None, :], axis=2).max())
+    tree = cKDTree(centroids)
+    n_facets = facets.shape[0]
+    out = np.empty(n)
+    todo = np.arange(n)
+    k = 8
+    while todo.size:
+        kk = min(k, n_facets)
+        pending = []
+        for start in range(0, todo.size, chunk_size):
+            idx = todo[start : start + chunk_size]
+            rho, cand = tree.query(x[idx], k=kk)
+            rho = rho.reshape(idx.size, kk)
+            cand = cand.reshape(idx.size, kk)
+            far = rho[:, 0] - radius > cap
+            out[idx[far]] = rho[far, 0] - radius
+            idx, rho, cand = idx[~far], rho[~far], cand[~far]
+            f = facets[cand]  # (m, kk, n_vertices, dim)
+            xp = x[idx][:, None, :]
+            if dim == 2:
+                d = _segment_distance(xp, f[:, :, 0], f[:, :, 1]).min(axis=1)
+            else:
+                d = _triangle_distance(xp, f[:, :, 0], f[:, :, 1], f[:, :, 2]).min(axis=1)
+            bound = rho[:, -1] - radius
+            done = (bound >= d) | (bound > cap) | (kk == n_facets)
+            out[idx[done]] = d[done]
+            pending.append(idx[~done])
+        todo = np.concatenate(pending)
+        k *= 4
+    return out
 
 
 def boundary_distance(mesh: Mesh, points: np.ndarray) -> np.ndarray:

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import skfem
-from arlequin.models import IsotropicElastic, LinearElastic
 
 from arlequin.coupling import MediatorError, coupling_matrices
+from arlequin.models import IsotropicElastic, LinearElastic
 from arlequin.overlap import OverlapError
 from arlequin.patches import refine_region
 from arlequin.problem import ArlequinProblem, Patch

@@ -13,9 +13,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import skfem
-from arlequin.models import IsotropicElastic, LinearElastic
 
 from arlequin.integrators.static import solve_static
+from arlequin.models import IsotropicElastic, LinearElastic
 from arlequin.patches import refine_region
 from arlequin.problem import ArlequinProblem, Patch
 

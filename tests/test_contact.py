@@ -8,6 +8,8 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 import skfem
+
+from arlequin.integrators import solve
 from arlequin.models import (
     ContactConvergenceError,
     ContactSurface,
@@ -22,8 +24,6 @@ from arlequin.models import (
     SphereObstacle,
     acoustic_impedance,
 )
-
-from arlequin.integrators import solve
 from arlequin.system import Block, BlockTerm, CoupledSystem
 
 STEEL = IsotropicElastic(210e9, 0.3, 7850.0)

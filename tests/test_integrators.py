@@ -13,7 +13,6 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 import skfem
-from arlequin.models import IsotropicElastic, LinearElastic
 from scipy.integrate import solve_ivp
 
 from arlequin.integrators import (
@@ -30,6 +29,7 @@ from arlequin.integrators import (
     solve,
     stable_time_step,
 )
+from arlequin.models import IsotropicElastic, LinearElastic
 from arlequin.system import Block, BlockTerm, CoupledSystem, LinearConstraint
 
 E, RHO, AREA, LENGTH = 3.0, 1.5, 0.5, 2.0
