@@ -14,9 +14,9 @@ import json
 
 import numpy as np
 import skfem
-from arlequin.models import IsotropicElastic, LinearElastic
 
 from arlequin import ArlequinProblem, Patch, refine_region, solve_static
+from arlequin.models import IsotropicElastic, LinearElastic
 
 
 def error(n: int, weights: str, mediator: str, coupling: str = "L2") -> float:

@@ -10,9 +10,9 @@ import json
 
 import numpy as np
 import skfem
-from arlequin.models import IsotropicElastic, LinearElastic
 
 import arlequin
+from arlequin.models import IsotropicElastic, LinearElastic
 
 
 def run(n: int = 8, levels: int = 2, traction: float = 1.0e6, coupling: str = "H1") -> dict:
