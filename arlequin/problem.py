@@ -199,6 +199,26 @@ class PatchCoupling:
             self._distance_cache[key] = self.distance(cell_centroids(mesh), self._distance_cap)
         return self._distance_cache[key]
 
+    def _centroids_within(
+        self, mesh, centroids: np.ndarray, d_nodes: np.ndarray, width: float
+    ) -> np.ndarray:
+        """Cells whose centroid lies within ``width`` of the interior boundary, shape (n_cells,).
+
+        The distance is 1-Lipschitz, so the vertex distances bound the centroid's:
+        max_v (d_v − |c − v|) ≤ d_c ≤ min_v (d_v + |c − v|). Only the cells these bounds leave
+        undecided (a thin layer along the band's inner edge) need the exact centroid distance.
+        """
+        r = np.linalg.norm(mesh.p[:, mesh.t] - centroids[:, None, :], axis=0)  # (n_v, n_cells)
+        dv = d_nodes[mesh.t]
+        lower = np.max(dv - r, axis=0)
+        upper = np.min(dv + r, axis=0)
+        inside = upper < width
+        undecided = ~inside & (lower < width)
+        if np.any(undecided):
+            exact = self.distance(centroids[:, undecided], self._distance_cap)
+            inside[np.nonzero(undecided)[0][exact < width]] = True
+        return inside
+
     def _gluing_zone(self) -> None:
         fmesh = self.fine_model.mesh
         centroids = cell_centroids(fmesh)
@@ -225,9 +245,8 @@ class PatchCoupling:
                     "coarse domain (give a gluing_region instead of a gluing_width)"
                 )
             w = float(self.patch.gluing_width)
-            dc = self._centroid_distance(fmesh)
-            fine_gluing = dc < w
             d_nodes = self._node_distance(fmesh)
+            fine_gluing = self._centroids_within(fmesh, centroids, d_nodes, w)
             # snap: the band's inner edge goes through the outer vertices of the selected cells
             width = float(d_nodes[fmesh.t[:, fine_gluing]].max()) if fine_gluing.any() else 0.0
             if fine_gluing.any() and abs(width - w) > 1e-9 * w:
