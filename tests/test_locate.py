@@ -13,6 +13,7 @@ import tracemalloc
 import numpy as np
 import pytest
 import skfem
+from _meshes import perturb
 
 from arlequin.locate import LocateResult, cell_centroids, cell_sizes, locate_points
 from arlequin.reference import (
@@ -25,34 +26,22 @@ from arlequin.reference import (
 KINDS = ["line", "tri", "quad", "tet", "hex"]
 
 
-def _perturb(mesh: skfem.Mesh, spacing: float, amount: float, seed: int) -> skfem.Mesh:
-    """Move interior nodes randomly by up to ``amount * spacing`` per coordinate.
-
-    Boundary nodes stay put, so the domain stays the box (planar boundary faces).
-    """
-    rng = np.random.default_rng(seed)
-    p = mesh.p.copy()
-    interior = np.setdiff1d(np.arange(mesh.nvertices), mesh.boundary_nodes())
-    p[:, interior] += amount * spacing * rng.uniform(-1.0, 1.0, (mesh.dim(), interior.size))
-    return type(mesh)(p, mesh.t)
-
-
 def make_mesh(kind: str) -> skfem.Mesh:
     """Meshes of the box [0, 1] x [0, Ly] (x [0, Lz]); quads and hexes are distorted."""
     if kind == "line":
         rng = np.random.default_rng(0)
         return skfem.MeshLine(np.sort(np.concatenate([[0.0, 1.0], rng.uniform(0, 1, 30)])))
     if kind == "tri":
-        return _perturb(skfem.MeshTri.init_symmetric().refined(3), 0.125, 0.15, 1)
+        return perturb(skfem.MeshTri.init_symmetric().refined(3), 0.125, 0.15, 1)
     if kind == "quad":
         m = skfem.MeshQuad.init_tensor(np.linspace(0, 1, 9), np.linspace(0, 2, 17))
-        return _perturb(m, 0.125, 0.2, 2)
+        return perturb(m, 0.125, 0.2, 2)
     if kind == "tet":
         return skfem.MeshTet.init_tensor(
             np.linspace(0, 1, 5), np.linspace(0, 1, 6), np.linspace(0, 2, 7)
         )
     m = skfem.MeshHex.init_tensor(*(np.linspace(0, 1, 6),) * 3)
-    return _perturb(m, 0.2, 0.2, 3)
+    return perturb(m, 0.2, 0.2, 3)
 
 
 def interior_ref(mesh: skfem.Mesh, n: int, rng: np.random.Generator, margin: float) -> np.ndarray:

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 import skfem
+from _meshes import perturb
 
 from arlequin.reference import (
     evaluate_basis,
@@ -32,31 +33,22 @@ ELEMENTS = {
 }
 
 
-def _perturb(mesh: skfem.Mesh, spacing: float, amount: float, seed: int) -> skfem.Mesh:
-    """Move interior nodes randomly by up to ``amount * spacing`` per coordinate."""
-    rng = np.random.default_rng(seed)
-    p = mesh.p.copy()
-    interior = np.setdiff1d(np.arange(mesh.nvertices), mesh.boundary_nodes())
-    p[:, interior] += amount * spacing * rng.uniform(-1.0, 1.0, (mesh.dim(), interior.size))
-    return type(mesh)(p, mesh.t)
-
-
 def make_mesh(kind: str) -> skfem.Mesh:
     """Small meshes of every supported type; quads and hexes are distorted (non-affine cells)."""
     if kind == "line":
         rng = np.random.default_rng(0)
         return skfem.MeshLine(np.sort(np.concatenate([[0.0, 1.0], rng.uniform(0, 1, 12)])))
     if kind == "tri":
-        return _perturb(skfem.MeshTri.init_symmetric().refined(2), 0.25, 0.15, 1)
+        return perturb(skfem.MeshTri.init_symmetric().refined(2), 0.25, 0.15, 1)
     if kind == "quad":
         m = skfem.MeshQuad.init_tensor(np.linspace(0, 1, 6), np.linspace(0, 2, 9))
-        return _perturb(m, 0.2, 0.2, 2)
+        return perturb(m, 0.2, 0.2, 2)
     if kind == "tet":
         return skfem.MeshTet.init_tensor(
             np.linspace(0, 1, 4), np.linspace(0, 1, 5), np.linspace(0, 2, 4)
         )
     m = skfem.MeshHex.init_tensor(*(np.linspace(0, 1, 5),) * 3)
-    return _perturb(m, 0.25, 0.2, 3)
+    return perturb(m, 0.25, 0.2, 3)
 
 
 def random_ref(kind: str, n: int, rng: np.random.Generator) -> np.ndarray:
