@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 from scipy.spatial import cKDTree
-from skfem import Mesh, MeshHex, MeshQuad
+from skfem import Mesh, MeshHex
 
 __all__ = ["boundary_distance", "distance_to_facets", "facet_coordinates"]
 
@@ -149,8 +149,3 @@ def distance_to_facets(
 def boundary_distance(mesh: Mesh, points: np.ndarray) -> np.ndarray:
     """Distance (m) from points (dim, n) to the boundary of ``mesh``, shape (n,)."""
     return distance_to_facets(points, facet_coordinates(mesh))
-
-
-def is_quad_like(mesh: Mesh) -> bool:
-    """True for tensor-product cells (quadrilaterals, hexahedra)."""
-    return isinstance(mesh, MeshQuad | MeshHex)

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-from skfem import Mesh, MeshLine, MeshTet, MeshTri
+from skfem import Mesh, MeshLine, MeshTri
 
 from .locate import LocateResult, cell_centroids, cell_sizes, locate_points
 from .reference import interpolation_matrix, map_to_physical
@@ -291,8 +291,3 @@ def _intersection_2d(coarse: Mesh, fine: Mesh) -> Overlap:
         fi[poly_of_tri],
         "intersection",
     )
-
-
-def is_simplex_mesh(mesh: Mesh) -> bool:
-    """True for lines, triangles and tetrahedra."""
-    return isinstance(mesh, MeshLine | MeshTri | MeshTet)

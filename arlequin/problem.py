@@ -154,9 +154,6 @@ class PatchCoupling:
         return float(np.mean(dx ** (1.0 / dim)))
 
     # ------------------------------------------------------------------ geometry
-    def _coarse_boundary_facets(self) -> np.ndarray:
-        return facet_coordinates(self.coarse_model.mesh)
-
     def on_coarse_boundary(self, x: np.ndarray) -> np.ndarray:
         """Whether points x (dim, n) lie on the coarse mesh's boundary (within boundary_tol h)."""
         cmesh = self.coarse_model.mesh
@@ -167,7 +164,7 @@ class PatchCoupling:
 
     def _classify_boundary(self) -> None:
         fmesh = self.fine_model.mesh
-        self._coarse_facets = self._coarse_boundary_facets()
+        self._coarse_facets = facet_coordinates(self.coarse_model.mesh)
         self._coarse_h = cell_sizes(self.coarse_model.mesh)
         bfacets = fmesh.boundary_facets()
         mid = fmesh.p[:, fmesh.facets[:, bfacets]].mean(axis=1)
