@@ -24,7 +24,17 @@ __all__ = [
     "CoupledSystem",
     "LinearConstraint",
     "Model",
+    "StateError",
 ]
+
+
+class StateError(ValueError):
+    """A model's state became invalid during a run (an inverted cell, a failed return mapping).
+
+    Models raise subclasses of it from ``internal_force``; the integrators turn it into a
+    :class:`~arlequin.integrators.SimulationError` naming the step and the time, and keep what
+    was recorded until then.
+    """
 
 
 class Model(Protocol):

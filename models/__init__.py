@@ -18,21 +18,33 @@ from .contact import (
     acoustic_impedance,
 )
 from .elastic import KINDS, IsotropicElastic, LinearElastic, scalar_element_for
+from .elastoplastic import (
+    FiniteStrainJ2,
+    InvertedElementError,
+    J2Material,
+    PlasticState,
+    hencky_j2_return,
+)
 
 __all__ = [
     "KINDS",
     "ContactConvergenceError",
     "ContactSurface",
     "DeformableContactPair",
+    "FiniteStrainJ2",
+    "InvertedElementError",
     "IsotropicElastic",
+    "J2Material",
     "LevelSetContact",
     "LevelSetObstacle",
     "LinearElastic",
     "Obstacle",
     "PlaneObstacle",
+    "PlasticState",
     "RigidContactPair",
     "SignoriniContact",
     "SphereObstacle",
     "acoustic_impedance",
+    "hencky_j2_return",
     "scalar_element_for",
 ]

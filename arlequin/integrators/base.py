@@ -33,7 +33,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..system import CoupledSystem, LinearConstraint
+from ..system import CoupledSystem, LinearConstraint, StateError
 from .constraints import UnilateralConstraint, is_unilateral
 
 __all__ = [
@@ -755,9 +755,21 @@ class Integrator:
         Raises
         ------
         SimulationError
-            If the new displacement or velocity is not finite (NaN or overflow).
+            If the new displacement or velocity is not finite (NaN or overflow), or a model
+            reports an invalid state (:class:`~arlequin.system.StateError`, e.g. an inverted
+            cell).
         """
-        self._step_impl()
+        t_start = self.t
+        try:
+            self._step_impl()
+        except StateError as err:
+            t_next = t_start + self.dt
+            raise SimulationError(
+                f"{self.name}: {err} at step {self.step_count + 1}, t = {t_next:.6e} s "
+                f"(dt = {self.dt:.6e} s)",
+                self.step_count + 1,
+                t_next,
+            ) from err
         self.step_count += 1
         if self.check_finite:
             # Σu² + Σv² (einsum's own loop, no multithreaded BLAS call): NaN, ±inf and values
