@@ -146,7 +146,30 @@ def _sym_eig(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     Returns values (3, ...) and vectors (3, 3, ...), the i-th vector being ``vectors[:, i]``.
     """
     w, v = np.linalg.eigh(np.moveaxis(a, (0, 1), (-2, -1)))
-    return np.moveaxis(w, -1, 0), np.moveaxis(v, (-2, -1), (0, 1))
+    # contiguous copies: einsum on the strided views is an order of magnitude slower
+    return (
+        np.ascontiguousarray(np.moveaxis(w, -1, 0)),
+        np.ascontiguousarray(np.moveaxis(v, (-2, -1), (0, 1))),
+    )
+
+
+def _sym_eig_planar(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """As :func:`_sym_eig` for tensors whose third axis is principal (a_02 = a_12 = 0).
+
+    Closed form for the in-plane 2×2 block (plane strain, axisymmetry), about 4× faster than
+    LAPACK's batched ``eigh`` here.
+    """
+    a00, a11, a01 = a[0, 0], a[1, 1], a[0, 1]
+    mean = 0.5 * (a00 + a11)
+    radius = np.hypot(0.5 * (a00 - a11), a01)
+    angle = 0.5 * np.arctan2(2.0 * a01, a00 - a11)
+    cos, sin = np.cos(angle), np.sin(angle)
+    values = np.stack([mean + radius, mean - radius, a[2, 2]])
+    vectors = np.zeros_like(a)
+    vectors[0, 0], vectors[1, 0] = cos, sin
+    vectors[0, 1], vectors[1, 1] = -sin, cos
+    vectors[2, 2] = 1.0
+    return values, vectors
 
 
 def _from_principal(values: np.ndarray, vectors: np.ndarray) -> np.ndarray:
@@ -155,7 +178,7 @@ def _from_principal(values: np.ndarray, vectors: np.ndarray) -> np.ndarray:
 
 
 def hencky_j2_return(
-    be_trial: np.ndarray, eqps: np.ndarray, material: J2Material
+    be_trial: np.ndarray, eqps: np.ndarray, material: J2Material, planar: bool = False
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Exponential-map radial return from a trial elastic left Cauchy–Green tensor.
 
@@ -166,6 +189,8 @@ def hencky_j2_return(
     eqps : ndarray, shape (...)
         Equivalent plastic strain at the start of the step.
     material : J2Material
+    planar : bool
+        The third axis is principal (plane strain, axisymmetry): closed-form 2×2 eigenvalues.
 
     Returns
     -------
@@ -177,7 +202,7 @@ def hencky_j2_return(
     delta_gamma : ndarray (...)
         Plastic multiplier of the step (0 where elastic).
     """
-    lam2, vec = _sym_eig(be_trial)
+    lam2, vec = _sym_eig_planar(be_trial) if planar else _sym_eig(be_trial)
     if not np.all(lam2 > 0.0):
         raise InvertedElementError(
             f"trial elastic stretch tensor is not positive definite (min eigenvalue "
@@ -407,7 +432,9 @@ class FiniteStrainJ2:
         else:
             Fbar = F
         be_trial = np.einsum("ikeq,kleq,jleq->ijeq", Fbar, state.cp_inv, Fbar)
-        tau, be, eqps, _ = hencky_j2_return(be_trial, state.eqps, self.material)
+        tau, be, eqps, _ = hencky_j2_return(
+            be_trial, state.eqps, self.material, planar=self.dim == 2
+        )
         Fbar_inv = Finv * np.cbrt(J / Jbar) if self.fbar else Finv
         cp_inv = np.einsum("ikeq,kleq,jleq->ijeq", Fbar_inv, be, Fbar_inv)
         w0 = alpha * self._dv0
@@ -449,7 +476,7 @@ class FiniteStrainJ2:
         if self.fbar:
             F = F * np.cbrt(self._mean_dilatation(J) / J)
         be = np.einsum("ikeq,kleq,jleq->ijeq", F, state.cp_inv, F)
-        eps = 0.5 * np.log(_sym_eig(be)[0])
+        eps = 0.5 * np.log((_sym_eig_planar(be) if self.dim == 2 else _sym_eig(be))[0])
         tr = eps.sum(axis=0)
         K, G = self.material.bulk_modulus, self.material.shear_modulus
         psi = 0.5 * K * tr**2 + G * np.sum((eps - tr / 3.0) ** 2, axis=0)

@@ -69,14 +69,15 @@ def uniaxial_strain_closed_form(strain: float, m: J2Material) -> tuple[float, fl
 # ------------------------------------------------------------------ constitutive update
 @pytest.mark.parametrize("strain", [1e-3, 0.05, 0.5, -0.7])
 @pytest.mark.parametrize("steps", [1, 25])
-def test_uniaxial_strain_matches_closed_form(strain, steps):
+@pytest.mark.parametrize("planar", [False, True])
+def test_uniaxial_strain_matches_closed_form(strain, steps, planar):
     ident = np.eye(3)[:, :, None]
     eqps = np.zeros(1)
     cp_inv = ident.copy()
     for k in range(1, steps + 1):
         F = np.diag([np.exp(strain * k / steps), 1.0, 1.0])[:, :, None]
         be_trial = np.einsum("ik...,kl...,jl...->ij...", F, cp_inv, F)
-        tau, be, eqps, _ = hencky_j2_return(be_trial, eqps, COPPER)
+        tau, be, eqps, _ = hencky_j2_return(be_trial, eqps, COPPER, planar=planar)
         Finv = np.linalg.inv(F[:, :, 0])[:, :, None]
         cp_inv = np.einsum("ik...,kl...,jl...->ij...", Finv, be, Finv)
     tau11, tau22, ep = uniaxial_strain_closed_form(strain, COPPER)
@@ -85,6 +86,21 @@ def test_uniaxial_strain_matches_closed_form(strain, steps):
     assert eqps[0] == pytest.approx(ep, rel=1e-10, abs=1e-14)
     # plastic flow is isochoric: det C_p⁻¹ = 1
     assert np.linalg.det(cp_inv[:, :, 0]) == pytest.approx(1.0, abs=1e-12)
+
+
+def test_planar_eigen_decomposition_matches_lapack():
+    # closed-form 2×2 + out-of-plane eigenpairs rebuild the tensor, degenerate cases included
+    from arlequin.models.elastoplastic import _from_principal, _sym_eig_planar
+
+    rng = np.random.default_rng(8)
+    a = np.zeros((3, 3, 50))
+    m = rng.normal(size=(2, 2, 50))
+    a[:2, :2] = np.einsum("ikn,jkn->ijn", m, m)
+    a[2, 2] = rng.uniform(0.1, 2.0, 50)
+    a[:2, :2, :5] = np.eye(2)[:, :, None]  # isotropic in-plane block
+    values, vectors = _sym_eig_planar(a)
+    assert np.allclose(_from_principal(values, vectors), a, atol=1e-13)
+    assert np.allclose(np.sort(values, axis=0), np.linalg.eigvalsh(a.transpose(2, 0, 1)).T)
 
 
 def test_objectivity_and_rigid_rotation():
