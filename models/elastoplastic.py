@@ -29,16 +29,16 @@ every integrand.
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
-from skfem import Basis, ElementHex1, ElementQuad1, Mesh, MeshHex, MeshQuad
+from skfem import Basis, Mesh, MeshHex, MeshQuad
 
 from arlequin.system import StateError
 
-from .elastic import IsotropicElastic, LinearElastic
+from .elastic import IsotropicElastic, LinearElastic, WeightLike
 
 __all__ = [
     "FiniteStrainJ2",
@@ -50,8 +50,6 @@ __all__ = [
 
 KINDS = ("plane_strain", "axisymmetric", "3d")
 SQRT23 = np.sqrt(2.0 / 3.0)
-
-WeightLike = float | np.ndarray | Callable[[np.ndarray], np.ndarray] | None
 
 
 class InvertedElementError(StateError):
@@ -262,8 +260,8 @@ class FiniteStrainJ2:
     interleaved by node like :class:`~arlequin.models.LinearElastic`
     (``dim * node + component``), and :meth:`mass`, :meth:`stiffness` (small-strain elastic, for
     stable-step estimates) come from a :class:`~arlequin.models.LinearElastic` on the same mesh
-    and quadrature. There is no
-    consistent tangent: the model is meant for explicit central differences.
+    and quadrature. There is no consistent tangent: the model is meant for explicit central
+    differences.
     """
 
     is_linear = False
@@ -287,12 +285,10 @@ class FiniteStrainJ2:
         self.fbar = bool(fbar)
         self.dim = dim
         self.intorder = 3
+        # checks r >= 0 in axisymmetry; gives the mass, the small-strain stiffness and the bases
         self.elastic = LinearElastic(mesh, material.elastic, kind=kind, intorder=self.intorder)
-        if kind == "axisymmetric" and np.min(mesh.p[0]) < 0.0:
-            raise ValueError(f"axisymmetric mesh needs r >= 0, got min r = {mesh.p[0].min()}")
         self.basis = self.elastic.basis
-        scalar = ElementQuad1() if dim == 2 else ElementHex1()
-        sb = Basis(mesh, scalar, intorder=self.intorder)
+        sb = self.elastic.scalar_basis()
         self._t = np.asarray(mesh.t)  # (n_nodes_per_cell, n_elems)
         nen = self._t.shape[0]
         # reference gradients ∇_X N_a and values N_a: (nen, dim, ne, nq), (nen, ne, nq)
@@ -371,22 +367,28 @@ class FiniteStrainJ2:
             raise ValueError(f"displacement must have shape ({self.n_dofs},), got {u.shape}")
         return u[self._cell_dofs]
 
-    def _deformation_gradient(self, ue, grad, val, radius) -> np.ndarray:
-        """F (3, 3, ne, nq) from cell displacements; in 2D F_zz = 1 or F_θθ = 1 + u_r/R."""
+    def deformation_gradient(self, u: np.ndarray) -> np.ndarray:
+        """Deformation gradient at the quadrature points, shape (3, 3, n_elems, n_qp).
+
+        In 2D, F_zz = 1 (plane strain) or F_θθ = 1 + u_r/R (axisymmetric).
+        """
+        ue = self._cell_displacements(u)
         d = self.dim
-        ne, nq = grad.shape[2:]
-        F = np.zeros((3, 3, ne, nq))
-        F[:d, :d] = np.einsum("iae,ajeq->ijeq", ue, grad)
+        F = np.zeros((3, 3, *self.shape))
+        F[:d, :d] = np.einsum("iae,ajeq->ijeq", ue, self._grad)
         for i in range(3):
             F[i, i] += 1.0
         if self.kind == "axisymmetric":
-            F[2, 2] += np.einsum("ae,aeq->eq", ue[0], val) / radius
+            F[2, 2] += np.einsum("ae,aeq->eq", ue[0], self._val) / self._radius
         return F
 
-    def deformation_gradient(self, u: np.ndarray) -> np.ndarray:
-        """Deformation gradient at the quadrature points, shape (3, 3, n_elems, n_qp)."""
-        ue = self._cell_displacements(u)
-        return self._deformation_gradient(ue, self._grad, self._val, self._radius)
+    def _kinematics(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, Any]:
+        """F, F⁻¹, J = det F (checked > 0) and the F-bar factor (J̄/J)^{1/3} (1 without F-bar)."""
+        F = self.deformation_gradient(u)
+        Finv, J = _inv3(F)
+        self._check_jacobian(J)
+        scale = np.cbrt(self._mean_dilatation(J) / J) if self.fbar else 1.0
+        return F, Finv, J, scale
 
     # ------------------------------------------------------------------ internal force
     def internal_force(
@@ -416,26 +418,19 @@ class FiniteStrainJ2:
         """
         state = self.initial_state() if state is None else state
         alpha = self.elastic.weight_at_quadrature(weight)
-        ue = self._cell_displacements(u)
-        F = self._deformation_gradient(ue, self._grad, self._val, self._radius)
-        Finv, J = _inv3(F)
-        self._check_jacobian(J)
+        F, Finv, J, scale = self._kinematics(u)
         # spatial gradients ∇ₓN_a = F⁻ᵀ ∇_X N_a (in-plane block) and the hoop term N_a / r
         d = self.dim
         gx = np.einsum("akeq,kjeq->ajeq", self._grad, Finv[:d, :d])
         hoop = None
         if self.kind == "axisymmetric":
             hoop = self._val / (self._radius * F[2, 2])  # N_a / r, (nen, ne, nq)
-        if self.fbar:
-            Jbar = self._mean_dilatation(J)
-            Fbar = F * np.cbrt(Jbar / J)
-        else:
-            Fbar = F
+        Fbar = F * scale
         be_trial = np.einsum("ikeq,kleq,jleq->ijeq", Fbar, state.cp_inv, Fbar)
         tau, be, eqps, _ = hencky_j2_return(
             be_trial, state.eqps, self.material, planar=self.dim == 2
         )
-        Fbar_inv = Finv * np.cbrt(J / Jbar) if self.fbar else Finv
+        Fbar_inv = Finv / scale
         cp_inv = np.einsum("ikeq,kleq,jleq->ijeq", Fbar_inv, be, Fbar_inv)
         w0 = alpha * self._dv0
         # f_{a,i} = Σ w0 [τ_ij ∇ₓN_a,j + (hoop) + p (div̄ − div) δ_i]
@@ -471,11 +466,9 @@ class FiniteStrainJ2:
     def stored_energy(self, u: np.ndarray, state: PlasticState, weight: WeightLike = None) -> float:
         """Elastic stored energy Σ w₀ ψ(ε_e) of a committed state at ``u`` (J)."""
         alpha = self.elastic.weight_at_quadrature(weight)
-        F = self.deformation_gradient(u)
-        J = _inv3(F)[1]
-        if self.fbar:
-            F = F * np.cbrt(self._mean_dilatation(J) / J)
-        be = np.einsum("ikeq,kleq,jleq->ijeq", F, state.cp_inv, F)
+        F, _, _, scale = self._kinematics(u)
+        Fbar = F * scale
+        be = np.einsum("ikeq,kleq,jleq->ijeq", Fbar, state.cp_inv, Fbar)
         eps = 0.5 * np.log((_sym_eig_planar(be) if self.dim == 2 else _sym_eig(be))[0])
         tr = eps.sum(axis=0)
         K, G = self.material.bulk_modulus, self.material.shear_modulus
