@@ -4,22 +4,39 @@ A coarse model of a whole structure and refined patches overlap, share the energ
 partition weights (α_coarse + α_fine = 1 in the overlap) and are glued by Lagrange-multiplier
 mediators (L2 or H1 coupling) on a gluing zone. Physics models live in :mod:`arlequin.models`.
 
-Public API
-----------
-ArlequinProblem, Patch          set up a coupled problem (:mod:`arlequin.problem`)
+Public API (``docs/api.md`` lists every name with the module it lives in)
+--------------------------------------------------------------------------
+ArlequinProblem, Patch,
+PatchCoupling                   set up a coupled problem (:mod:`arlequin.problem`,
+                                :mod:`arlequin.gluing`)
 refine_region                   nested patches from coarse cells (:mod:`arlequin.patches`)
 RampWeights, ConstantWeights,
 CallableWeights                 partition weights (:mod:`arlequin.weights`)
-solve_static                    static saddle-point solve (:mod:`arlequin.integrators.static`)
+solve_static, solve             static and dynamic solves (:mod:`arlequin.integrators`)
+DofMap                          the dof layout of a coupled system (:mod:`arlequin.dofs`)
+ResultsFolder                   results on disk (:mod:`arlequin.io`)
 evaluate_field, locate_points   fields at points, bounded point locator
+errors                          ``ValueError`` subclasses naming the quantity and its value
 """
 
+from .contract import (
+    CapabilityError,
+    ConstraintError,
+    ContractError,
+    SimulationError,
+    StateError,
+)
+from .coupling import MediatorError
+from .dofs import DofMap
 from .fields import evaluate_field
-from .integrators.static import StaticResult, solve_static
+from .gluing import Patch, PatchCoupling
+from .integrators import DynamicResult, solve
+from .integrators.static import SingularSystemError, StaticResult, solve_static
+from .io import ResultsFolder
 from .locate import locate_points
 from .overlap import Overlap, OverlapError, build_overlap
 from .patches import refine_region
-from .problem import ArlequinProblem, Patch
+from .problem import ArlequinProblem
 from .weights import CallableWeights, ConstantWeights, RampWeights, WeightSumError
 
 __version__ = "0.1.0"
@@ -27,16 +44,28 @@ __version__ = "0.1.0"
 __all__ = [
     "ArlequinProblem",
     "CallableWeights",
+    "CapabilityError",
     "ConstantWeights",
+    "ConstraintError",
+    "ContractError",
+    "DofMap",
+    "DynamicResult",
+    "MediatorError",
     "Overlap",
     "OverlapError",
     "Patch",
+    "PatchCoupling",
     "RampWeights",
+    "ResultsFolder",
+    "SimulationError",
+    "SingularSystemError",
+    "StateError",
     "StaticResult",
     "WeightSumError",
     "build_overlap",
     "evaluate_field",
     "locate_points",
     "refine_region",
+    "solve",
     "solve_static",
 ]

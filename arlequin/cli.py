@@ -1,7 +1,9 @@
 """The ``arlequin`` command: a thin layer over :mod:`arlequin.demos`.
 
 Each subcommand runs one demo, prints a one-line summary and optionally writes JSON (SI units;
-``*_error`` and ``*_fraction`` values are dimensionless fractions, not percent).
+``*_error`` and ``*_fraction`` values are dimensionless fractions, not percent) and a results
+folder (``--out DIR``: results.json with the inputs and their units, history.csv, XDMF field
+series that ParaView opens, pictures; see :mod:`arlequin.io`).
 """
 
 from __future__ import annotations
@@ -9,6 +11,7 @@ from __future__ import annotations
 import argparse
 import json
 import logging
+import os
 import sys
 from collections.abc import Sequence
 
@@ -21,6 +24,26 @@ def _write_json(path: str | None, data: dict) -> None:
             json.dump(data, fh, indent=2)
 
 
+def _check_writable(path: str | None, option: str) -> None:
+    """Refuse, before any computation, an output file whose folder cannot be written."""
+    if not path:
+        return
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder) or not os.access(folder, os.W_OK):
+        raise ValueError(
+            f"{option} {path!r}: the folder {folder!r} does not exist or is not writable"
+        )
+
+
+def _add_out(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--out",
+        metavar="DIR",
+        default=None,
+        help="write a results folder: results.json, history.csv, fields/*.xdmf, pictures",
+    )
+
+
 def _cmd_patch_test(args: argparse.Namespace) -> int:
     from .demos.patch_test import run_patch_test
 
@@ -31,6 +54,7 @@ def _cmd_patch_test(args: argparse.Namespace) -> int:
         mediator=args.mediator,
         mesh=args.mesh,
         seed=args.seed,
+        out=args.out,
     )
     print(result.summary())
     keys = ("max_error", "exact_residual", "n_coarse_dofs", "n_fine_dofs", "n_multipliers")
@@ -54,6 +78,7 @@ def _add_patch_test(sub) -> None:
     p.add_argument("--mesh", choices=["nested", "nonnested"], default="nested")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--json", metavar="PATH", default=None, help="write the results as JSON")
+    _add_out(p)
     p.set_defaults(func=_cmd_patch_test)
 
 
@@ -72,6 +97,7 @@ def _cmd_two_bars(args: argparse.Namespace) -> int:
         cfl=args.cfl,
         theta=args.theta,
         t_end=args.t_end,
+        out=args.out,
     )
     print(result.summary())
     _write_json(args.json, result.to_json())
@@ -117,6 +143,7 @@ def _add_two_bars(sub) -> None:
     )
     p.add_argument("--json", metavar="PATH", default=None, help="write the histories as JSON")
     p.add_argument("--plot", metavar="PNG", default=None, help="plot against the exact solution")
+    _add_out(p)
     p.set_defaults(func=_cmd_two_bars)
 
 
@@ -132,6 +159,7 @@ def _cmd_wave(args: argparse.Namespace) -> int:
         weights=args.weights,
         integrator=args.integrator,
         dt=args.dt,
+        out=args.out,
     )
     print(result.summary())
     _write_json(args.json, result.to_json())
@@ -163,6 +191,7 @@ def _add_wave(sub) -> None:
     )
     p.add_argument("--json", metavar="PATH", default=None, help="write the results as JSON")
     p.add_argument("--plot", metavar="PNG", default=None, help="write a picture of the snapshot")
+    _add_out(p)
     p.set_defaults(func=_cmd_wave)
 
 
@@ -186,6 +215,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         format="%(levelname)s %(name)s: %(message)s",
     )
     try:
+        for attr in ("json", "plot"):
+            _check_writable(getattr(args, attr, None), f"--{attr}")
         return int(args.func(args) or 0)
     except ValueError as exc:
         print(f"arlequin {args.command}: error: {exc}", file=sys.stderr)

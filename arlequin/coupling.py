@@ -25,8 +25,9 @@ import scipy.sparse as sp
 from skfem import Basis, BilinearForm, ElementVector
 from skfem.helpers import dot, grad
 
-from .elements import scalar_element_for
+from .dofs import node_dofs
 from .overlap import Overlap
+from .reference import scalar_element_for
 
 __all__ = ["CouplingMatrices", "MediatorError", "coupling_matrices", "gram_matrix"]
 
@@ -151,7 +152,7 @@ def coupling_matrices(
     # mediator functions = those of the chosen model whose support meets S_g with positive measure
     mesh = overlap.integration_mesh
     gluing_nodes = np.unique(mesh.t[:, np.asarray(gluing_cells)])
-    rows = (gluing_nodes[:, None] * n_components + np.arange(n_components)).ravel()
+    rows = node_dofs(gluing_nodes, n_components).T.ravel()
     support = np.asarray(abs(pm[rows]).max(axis=0).todense()).ravel() > 1e-12
     mediator_dofs = np.nonzero(support)[0]
     if mediator_dofs.size == 0:

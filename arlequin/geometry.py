@@ -11,7 +11,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 from skfem import Mesh, MeshHex
 
-__all__ = ["boundary_distance", "distance_to_facets", "facet_coordinates"]
+__all__ = ["boundary_distance", "cyclic_quad_faces", "distance_to_facets", "facet_coordinates"]
 
 
 def facet_coordinates(mesh: Mesh, facets: np.ndarray | None = None) -> np.ndarray:
@@ -25,12 +25,25 @@ def facet_coordinates(mesh: Mesh, facets: np.ndarray | None = None) -> np.ndarra
     facets = np.asarray(facets, dtype=np.int64)
     f = mesh.facets[:, facets]
     if isinstance(mesh, MeshHex) and f.shape[0] == 4:
-        f = _cyclic_quad_faces(mesh.p, f)
+        f = cyclic_quad_faces(mesh.p, f)
     return np.transpose(mesh.p[:, f], (2, 1, 0))
 
 
-def _cyclic_quad_faces(p: np.ndarray, f: np.ndarray) -> np.ndarray:
-    """Reorder the 4 vertices of each quadrilateral face so that they go around the face."""
+def cyclic_quad_faces(p: np.ndarray, f: np.ndarray) -> np.ndarray:
+    """Reorder the 4 vertices of each quadrilateral face so that they go around the face.
+
+    Parameters
+    ----------
+    p : ndarray, shape (3, n_points)
+        Point coordinates.
+    f : ndarray of int, shape (4, n_faces)
+        Vertex indices of each planar (or nearly planar) quadrilateral face, in any order.
+
+    Returns
+    -------
+    ndarray of int, shape (4, n_faces)
+        The same vertices in cyclic order (by angle about the face centre).
+    """
     # scikit-fem stores hex faces with sorted vertex indices; order them by angle about the centre.
     xyz = p[:, f]  # (3, 4, nf)
     c = xyz.mean(axis=1, keepdims=True)

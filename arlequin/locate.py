@@ -27,6 +27,9 @@ quadrilaterals: the closest point of each face of the simplex (or each edge of t
 is found by projecting onto every sub-simplex and keeping the feasible projections. For
 hexahedra each (generally non-planar, bilinear) face is split along a diagonal into two
 triangles, so the distance is exact for planar faces and otherwise accurate to the face warping.
+
+Size: one concept (the bounded locator: candidates, inclusion tests, distances, the outside
+points) whose pieces share the work-array bounds; splitting it would scatter that invariant.
 """
 
 from __future__ import annotations
@@ -40,6 +43,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 from skfem import Mesh
 
+from .geometry import cyclic_quad_faces
 from .reference import (
     ReferenceElement,
     _inverse_small,
@@ -303,10 +307,7 @@ def _boundary_subsets(ref_el: ReferenceElement) -> list[tuple[int, ...]]:
             pieces = []
             for axis, side in itertools.product(range(3), (0.0, 1.0)):
                 face = [i for i in range(n) if v[i, axis] == side]
-                # order the 4 face vertices cyclically by their angle about the face centre
-                other = [a for a in range(3) if a != axis]
-                uv = v[face][:, other] - 0.5
-                face = [face[i] for i in np.argsort(np.arctan2(uv[:, 1], uv[:, 0]))]
+                face = cyclic_quad_faces(v.T, np.array(face)[:, None])[:, 0].tolist()
                 pieces += [(face[0], face[1], face[2]), (face[0], face[2], face[3])]
     subsets: set[tuple[int, ...]] = set()
     for piece in pieces:

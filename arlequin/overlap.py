@@ -32,6 +32,7 @@ import numpy as np
 import scipy.sparse as sp
 from skfem import Mesh, MeshLine, MeshTri
 
+from .dofs import vector_operator
 from .locate import LocateResult, cell_centroids, cell_sizes, locate_points
 from .reference import interpolation_matrix, map_to_physical
 
@@ -82,9 +83,7 @@ class Overlap:
         scipy.sparse.csr_matrix, shape (n_components n_I_nodes, n_components n_model_nodes)
         """
         p = self.coarse_transfer if which == "coarse" else self.fine_transfer
-        if n_components == 1:
-            return p
-        return sp.kron(p, sp.identity(n_components, format="csr"), format="csr")
+        return vector_operator(p, n_components)
 
 
 def _located(mesh: Mesh, points: np.ndarray, tol: float, what: str) -> LocateResult:

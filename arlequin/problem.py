@@ -16,332 +16,22 @@ from __future__ import annotations
 import logging
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from functools import cached_property
 from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
 
-from .coupling import CouplingMatrices, MediatorError, coupling_matrices
-from .geometry import distance_to_facets, facet_coordinates
-from .locate import cell_centroids, cell_sizes, locate_points
-from .overlap import Overlap, OverlapError, build_overlap
+from .contract import ContractError, Model, check_protocol
+from .dofs import DofMap
+from .gluing import Patch, PatchCoupling
+from .io.layout import BlockFields, FieldLayout
+from .locate import cell_centroids, locate_points
+from .overlap import OverlapError
 from .system import Block, BlockTerm, CoupledSystem, LinearConstraint
-from .weights import PartitionWeights, check_partition_of_unity, make_weights
 
 __all__ = ["ArlequinProblem", "Patch", "PatchCoupling"]
 
 logger = logging.getLogger(__name__)
-
-
-@dataclass
-class Patch:
-    """A refined model superposed on part of the coarse model.
-
-    Parameters
-    ----------
-    model : Model
-        The patch's model on its own (fine) mesh.
-    gluing_width : float, optional
-        Width (m) of the gluing band inside the patch along its interior boundary (the part of
-        its boundary inside the coarse domain). Snapped outwards to the fine cells whose centroid
-        lies within it, so the band's inner edge is made of fine-cell faces.
-    weights : {"ramp", "constant"} or PartitionWeights
-    epsilon : float
-        Floor of α_coarse inside the patch beyond the band.
-    coupling : {"L2", "H1"}
-    mediator : {"coarse", "fine"}
-    length : float, optional
-        H1 coupling length ℓ (m); default: the mean coarse cell size on the gluing zone
-        (:meth:`PatchCoupling.default_h1_length`).
-    gluing_region : callable, optional
-        Instead of a band: fine cells whose centroid x (dim, n) satisfies ``gluing_region(x)``.
-    overlap_method : {"auto", "nested", "intersection"}
-        See :func:`arlequin.overlap.build_overlap`.
-    boundary_tol : float
-        Fraction of the local coarse cell size within which patch points outside the coarse mesh
-        are accepted (faceted curved boundaries) and patch facets count as lying on the coarse
-        boundary.
-    name : str, optional
-        Block name; default ``"patch<i>"``.
-    """
-
-    model: Any
-    gluing_width: float | None = None
-    weights: str | PartitionWeights = "ramp"
-    epsilon: float = 1e-3
-    coupling: str = "H1"
-    mediator: str = "coarse"
-    length: float | None = None
-    gluing_region: Callable[[np.ndarray], np.ndarray] | None = None
-    overlap_method: str = "auto"
-    boundary_tol: float = 0.05
-    name: str | None = None
-
-    def __post_init__(self) -> None:
-        if self.gluing_width is None and self.gluing_region is None:
-            raise ValueError("a patch needs a gluing_width (m) or a gluing_region")
-        if self.gluing_width is not None and not self.gluing_width > 0.0:
-            raise ValueError(f"gluing_width must be positive, got gluing_width={self.gluing_width}")
-        if self.coupling not in ("L2", "H1"):
-            raise ValueError(f"coupling must be 'L2' or 'H1', got {self.coupling!r}")
-        if self.mediator not in ("coarse", "fine"):
-            raise ValueError(f"mediator must be 'coarse' or 'fine', got {self.mediator!r}")
-        if self.length is not None and not self.length > 0.0:
-            raise ValueError(f"H1 length must be positive, got length={self.length}")
-        self.weights = make_weights(self.weights, self.epsilon)
-
-
-class PatchCoupling:
-    """Everything computed for one patch: overlap, weights, gluing zone, coupling matrices.
-
-    Built by :class:`ArlequinProblem`; exposed for post-processing and tests.
-    """
-
-    def __init__(self, coarse_model: Any, patch: Patch, name: str) -> None:
-        self.patch = patch
-        self.name = name
-        self.coarse_model = coarse_model
-        self.fine_model = patch.model
-        self.weights: PartitionWeights = patch.weights  # type: ignore[assignment]
-        cmesh, fmesh = coarse_model.mesh, patch.model.mesh
-        self.overlap: Overlap = build_overlap(
-            cmesh, fmesh, patch.overlap_method, patch.boundary_tol
-        )
-        self.n_components = int(coarse_model.n_components)
-        if int(patch.model.n_components) != self.n_components:
-            raise ValueError(
-                f"mismatched dimensions: coarse model has {self.n_components} displacement "
-                f"components, patch {name} has {patch.model.n_components}"
-            )
-        if getattr(coarse_model, "kind", None) != getattr(patch.model, "kind", None):
-            raise ValueError(
-                f"mismatched kinematics: coarse kind={getattr(coarse_model, 'kind', None)!r}, "
-                f"patch kind={getattr(patch.model, 'kind', None)!r}"
-            )
-        self.axisymmetric = getattr(coarse_model, "kind", None) == "axisymmetric"
-        self._classify_boundary()
-        self._gluing_zone()
-        self.integration_model = coarse_model.with_mesh(self.overlap.integration_mesh)
-        self._evaluate_weights()
-        length = patch.length if patch.length is not None else self.default_h1_length()
-        self.coupling: CouplingMatrices = coupling_matrices(
-            self.overlap,
-            self.gluing_cells,
-            self.n_components,
-            patch.coupling,
-            length,
-            patch.mediator,
-            self.axisymmetric,
-        )
-
-    def default_h1_length(self) -> float:
-        """Default H1 coupling length ℓ (m): the mean coarse cell size on the gluing zone.
-
-        Cell size = (cell measure)^(1/dim). A length of the order of the gluing width (the other
-        common choice) weights the strain term so heavily that waves reflect at the band: in the
-        1D wave check (ratio 4 and 8, band of 10 coarse cells, pulses of 10 cells) ℓ = the band
-        width reflects 1.7e-4 and 2.5e-4 of the incident energy, ℓ = one coarse cell 3.0e-5 and
-        4.5e-5 (docs/dynamics.md). Patch tests are exact for any ℓ.
-        """
-        parents = np.unique(self.overlap.coarse_cells[self.gluing_cells])
-        dx = self.coarse_model.scalar_basis().dx.sum(axis=1)[parents]
-        dim = self.coarse_model.mesh.dim()
-        if self.axisymmetric:
-            # the measure carries 2π r: use the cell's plane area instead
-            c = cell_centroids(self.coarse_model.mesh)[0, parents]
-            dx = dx / (2.0 * np.pi * np.maximum(c, 1e-300))
-        return float(np.mean(dx ** (1.0 / dim)))
-
-    # ------------------------------------------------------------------ geometry
-    def on_coarse_boundary(self, x: np.ndarray) -> np.ndarray:
-        """Whether points x (dim, n) lie on the coarse mesh's boundary (within boundary_tol h)."""
-        cmesh = self.coarse_model.mesh
-        dist = distance_to_facets(x, self._coarse_facets)
-        loc = locate_points(cmesh, x, tol=max(self.patch.boundary_tol, 1e-6))
-        h = np.where(loc.cells >= 0, self._coarse_h[np.maximum(loc.cells, 0)], self._coarse_h.max())
-        return dist <= self.patch.boundary_tol * h
-
-    def _classify_boundary(self) -> None:
-        fmesh = self.fine_model.mesh
-        self._coarse_facets = facet_coordinates(self.coarse_model.mesh)
-        self._coarse_h = cell_sizes(self.coarse_model.mesh)
-        bfacets = fmesh.boundary_facets()
-        mid = fmesh.p[:, fmesh.facets[:, bfacets]].mean(axis=1)
-        on = self.on_coarse_boundary(mid)
-        self.outer_facets = bfacets[on]
-        self.interior_facets = bfacets[~on]
-        self._interior_coords = facet_coordinates(fmesh, self.interior_facets)
-
-    def distance(self, x: np.ndarray, cap: float | None = None) -> np.ndarray:
-        """Distance (m) from points x (dim, ...) to the patch's interior boundary, shape (...).
-
-        With ``cap``, distances beyond it are lower bounds above it (weights saturate there).
-        """
-        shape = x.shape[1:]
-        flat = x.reshape(x.shape[0], -1)
-        return distance_to_facets(flat, self._interior_coords, cap=cap).reshape(shape)
-
-    def _node_distance(self, mesh) -> np.ndarray:
-        """Capped distances of a mesh's nodes, computed once per mesh."""
-        key = ("nodes", id(mesh))
-        if key not in self._distance_cache:
-            self._distance_cache[key] = self.distance(mesh.p, self._distance_cap)
-        return self._distance_cache[key]
-
-    def _centroid_distance(self, mesh) -> np.ndarray:
-        """Capped distances of a mesh's cell centroids, computed once per mesh."""
-        key = ("cells", id(mesh))
-        if key not in self._distance_cache:
-            self._distance_cache[key] = self.distance(cell_centroids(mesh), self._distance_cap)
-        return self._distance_cache[key]
-
-    def _centroids_within(
-        self, mesh, centroids: np.ndarray, d_nodes: np.ndarray, width: float
-    ) -> np.ndarray:
-        """Cells whose centroid lies within ``width`` of the interior boundary, shape (n_cells,).
-
-        The distance is 1-Lipschitz, so the vertex distances bound the centroid's:
-        max_v (d_v − |c − v|) ≤ d_c ≤ min_v (d_v + |c − v|). Only the cells these bounds leave
-        undecided (a thin layer along the band's inner edge) need the exact centroid distance.
-        """
-        r = np.linalg.norm(mesh.p[:, mesh.t] - centroids[:, None, :], axis=0)  # (n_v, n_cells)
-        dv = d_nodes[mesh.t]
-        lower = np.max(dv - r, axis=0)
-        upper = np.min(dv + r, axis=0)
-        inside = upper < width
-        undecided = ~inside & (lower < width)
-        if np.any(undecided):
-            exact = self.distance(centroids[:, undecided], self._distance_cap)
-            inside[np.nonzero(undecided)[0][exact < width]] = True
-        return inside
-
-    def _gluing_zone(self) -> None:
-        fmesh = self.fine_model.mesh
-        centroids = cell_centroids(fmesh)
-        self._distance_cache: dict = {}
-        # distances only matter up to the band width (weights saturate beyond it): exact up to
-        # the width plus one fine cell, lower bounds beyond
-        self._distance_cap = (
-            None
-            if self.patch.gluing_width is None
-            else float(self.patch.gluing_width) + float(cell_sizes(fmesh).max())
-        )
-        if self.patch.gluing_region is not None:
-            fine_gluing = np.asarray(self.patch.gluing_region(centroids), dtype=bool)
-            d_nodes = (
-                self._node_distance(fmesh)
-                if self.interior_facets.size
-                else np.zeros(fmesh.nvertices)
-            )
-            width = float(d_nodes[fmesh.t[:, fine_gluing]].max()) if fine_gluing.any() else 0.0
-        else:
-            if self.interior_facets.size == 0:
-                raise MediatorError(
-                    f"empty gluing zone for {self.name}: the patch boundary has no part inside the "
-                    "coarse domain (give a gluing_region instead of a gluing_width)"
-                )
-            w = float(self.patch.gluing_width)
-            d_nodes = self._node_distance(fmesh)
-            fine_gluing = self._centroids_within(fmesh, centroids, d_nodes, w)
-            # snap: the band's inner edge goes through the outer vertices of the selected cells
-            width = float(d_nodes[fmesh.t[:, fine_gluing]].max()) if fine_gluing.any() else 0.0
-            if fine_gluing.any() and abs(width - w) > 1e-9 * w:
-                logger.info("%s: gluing width %.6g m snapped to %.6g m", self.name, w, width)
-        if not fine_gluing.any() or width <= 0.0:
-            raise MediatorError(
-                f"empty gluing zone for {self.name}: no patch cell lies within the gluing band "
-                f"(gluing_width={self.patch.gluing_width})"
-            )
-        self.gluing_width = width
-        self.fine_gluing_cells = np.nonzero(fine_gluing)[0]
-        self.gluing_cells = np.nonzero(fine_gluing[self.overlap.fine_cells])[0]
-        if self.gluing_cells.size == 0:
-            raise MediatorError(
-                f"empty gluing zone for {self.name}: it does not overlap the coarse mesh"
-            )
-
-    # ------------------------------------------------------------------ weights
-    def _weights_at(self, basis, which: str) -> np.ndarray:
-        """α_which at the quadrature points of a scalar cell basis, shape (n_elems, n_qp)."""
-        mesh = basis.mesh
-        fn = self.weights.alpha_coarse if which == "coarse" else self.weights.alpha_fine
-        mode = self.weights.mode
-        if mode == "nodal":
-            nodal = fn(mesh.p, self._node_distance(mesh), self.gluing_width)
-            return np.asarray(basis.interpolate(np.asarray(nodal, dtype=float)))
-        if mode == "cell":
-            c = cell_centroids(mesh)
-            per_cell = np.asarray(
-                fn(c, self._centroid_distance(mesh), self.gluing_width), dtype=float
-            )
-            return np.repeat(per_cell[:, None], basis.dx.shape[1], axis=1)
-        x = np.asarray(basis.global_coordinates())
-        return np.broadcast_to(
-            fn(x, self.distance(x, self._distance_cap), self.gluing_width), basis.dx.shape
-        ).copy()
-
-    def weight_function(self, which: str) -> Callable[[np.ndarray], np.ndarray]:
-        """Pointwise α_which(x) for x (dim, ...) (used on boundary facets)."""
-        fn = self.weights.alpha_coarse if which == "coarse" else self.weights.alpha_fine
-        return lambda x: fn(x, self.distance(x, self._distance_cap), self.gluing_width)
-
-    def _evaluate_weights(self) -> None:
-        ibasis = self.integration_model.scalar_basis()
-        alpha_c = self._weights_at(ibasis, "coarse")
-        alpha_f = self._weights_at(ibasis, "fine")
-        check_partition_of_unity(alpha_c, alpha_f, np.asarray(ibasis.mapping.F(ibasis.X)))
-        self.alpha_fine_overlap = alpha_f
-        self.alpha_coarse_overlap = alpha_c
-        self.alpha_fine = self._weights_at(self.fine_model.scalar_basis(), "fine")
-
-    # ------------------------------------------------------------------ operators
-    @cached_property
-    def coarse_transfer(self) -> sp.csr_matrix:
-        """Vector transfer coarse dofs -> integration-mesh dofs."""
-        return self.overlap.vector_transfer("coarse", self.n_components)
-
-    @cached_property
-    def covered_coarse_cells(self) -> np.ndarray:
-        """Coarse cells entirely covered by the integration mesh (boolean, (n_coarse_cells,)).
-
-        On these the coarse model's terms are integrated on the overlap cells only, with weight
-        α_coarse; on partly covered cells (non-nested overlaps) the overlap part −α_fine is
-        subtracted from the full-cell integral. Never subtracting on fully covered cells keeps
-        the weighted coarse operators positive even where Gauss quadrature is not exact
-        (distorted quadrilaterals) and α_coarse = ε is small.
-        """
-        cmesh = self.coarse_model.mesh
-        imodel = self.integration_model
-        i_measure = np.bincount(
-            self.overlap.coarse_cells,
-            weights=imodel.scalar_basis().dx.sum(axis=1),
-            minlength=cmesh.nelements,
-        )
-        c_measure = self.coarse_model.scalar_basis().dx.sum(axis=1)
-        # >=: a patch whose nodes were projected onto a convex curved boundary can cover a
-        # coarse cell by more than its measure; subtracting there would give a negative weight
-        return i_measure >= (1.0 - 1e-9) * c_measure
-
-    def coarse_overlap_term(self) -> BlockTerm:
-        """The coarse model's contribution inside the overlap, integrated on the overlap cells.
-
-        Weight α_coarse on the overlap cells of fully covered coarse cells, −α_fine on those of
-        partly covered ones (see :attr:`covered_coarse_cells`).
-        """
-        covered = self.covered_coarse_cells[self.overlap.coarse_cells]
-        weight = np.where(covered[:, None], self.alpha_coarse_overlap, -self.alpha_fine_overlap)
-        return BlockTerm(self.integration_model, weight, self.coarse_transfer, 1.0)
-
-    def fine_term(self) -> BlockTerm:
-        return BlockTerm(self.fine_model, self.alpha_fine)
-
-    def integration_boundary_facets(self) -> np.ndarray:
-        """Boundary facets of the integration mesh that lie on the coarse mesh's boundary."""
-        imesh = self.overlap.integration_mesh
-        bf = imesh.boundary_facets()
-        mid = imesh.p[:, imesh.facets[:, bf]].mean(axis=1)
-        return bf[self.on_coarse_boundary(mid)]
 
 
 def _facet_midpoints(mesh, facets: np.ndarray) -> np.ndarray:
@@ -383,7 +73,14 @@ class ArlequinProblem:
     patches: Sequence[Patch] = field(default_factory=list)
 
     def __post_init__(self) -> None:
+        check_protocol(self.coarse, Model, "the coarse model")
         self.patches = list(self.patches)
+        for i, p in enumerate(self.patches):
+            if not isinstance(p, Patch):
+                raise ContractError(
+                    f"patch {i} is a {type(p).__name__}; wrap its model in arlequin.Patch(model, "
+                    "gluing_width=...)"
+                )
         self._loads: list[_Load] = []
         self._dirichlet: list[_Dirichlet] = []
         self._couplings: list[PatchCoupling] | None = None
@@ -547,38 +244,22 @@ class ArlequinProblem:
         coarse_terms += [pc.coarse_overlap_term() for pc in couplings]
         blocks = [Block("coarse", self.coarse, coarse_terms)]
         blocks += [Block(pc.name, pc.fine_model, [pc.fine_term()]) for pc in couplings]
-        offsets = np.cumsum([0] + [b.n_dofs for b in blocks])
-        n = int(offsets[-1])
-        index = {b.name: int(o) for b, o in zip(blocks, offsets[:-1])}
+        dofmap = self.dofmap()
+        n = dofmap.n_dofs
 
         constraints: list[LinearConstraint] = []
         for pc in couplings:
             cm = pc.coupling
-            c_coarse = sp.csr_matrix(
-                (cm.coarse.data, cm.coarse.indices, cm.coarse.indptr), shape=(cm.n_multipliers, n)
-            )
-            fine = sp.hstack(
-                [
-                    sp.csr_matrix((cm.n_multipliers, index[pc.name])),
-                    -cm.fine,
-                    sp.csr_matrix((cm.n_multipliers, n - index[pc.name] - cm.fine.shape[1])),
-                ],
-                format="csr",
-            )
+            rows = dofmap.embed("coarse", cm.coarse) - dofmap.embed(pc.name, cm.fine)
             constraints.append(
-                LinearConstraint(
-                    (c_coarse + fine).tocsr(), None, f"coupling:{pc.name}", kind="coupling"
-                )
+                LinearConstraint(rows.tocsr(), None, f"coupling:{pc.name}", kind="coupling")
             )
         for k, bc in enumerate(self._dirichlet):
-            constraints.append(self._dirichlet_rows(bc, index[bc.block], n, k))
+            constraints.append(self._dirichlet_rows(bc, dofmap, k))
 
         parts = []
         for load in self._loads:
-            vecs = self._load_vectors(load)
-            full = np.zeros(n)
-            for name, vec in vecs.items():
-                full[index[name] : index[name] + vec.size] += vec
+            full = dofmap.assemble(self._load_vectors(load), "load vector")
             parts.append((full, load.amplitude))
 
         def load_fn(t: float, parts=parts, n=n) -> np.ndarray:
@@ -589,7 +270,42 @@ class ArlequinProblem:
 
         return CoupledSystem(blocks, constraints, load_fn)
 
-    def _dirichlet_rows(self, bc: _Dirichlet, offset: int, n: int, k: int) -> LinearConstraint:
+    def field_layout(self) -> FieldLayout:
+        """What a results folder shows of this problem: each block's mesh with its cell-mean
+        partition weight ``alpha``, and the multiplier field of each mediator on the nodes of
+        the model whose space carries it."""
+        cbasis = self.coarse.scalar_basis()
+        c_measure = cbasis.dx.sum(axis=1)
+        fine_share = np.zeros(self.coarse.mesh.nelements)
+        blocks = []
+        multipliers = {}
+        for pc in self.couplings:
+            ibasis = pc.integration_model.scalar_basis()
+            fine_share += np.bincount(
+                pc.overlap.coarse_cells,
+                weights=(pc.alpha_fine_overlap * ibasis.dx).sum(axis=1),
+                minlength=fine_share.size,
+            )
+            fdx = pc.fine_model.scalar_basis().dx
+            alpha = (pc.alpha_fine * fdx).sum(axis=1) / fdx.sum(axis=1)
+            blocks.append(
+                BlockFields(pc.name, pc.fine_model.mesh, pc.n_components, {"alpha": alpha})
+            )
+            carrier = "coarse" if pc.coupling.mediator == "coarse" else pc.name
+            multipliers[f"coupling:{pc.name}"] = (carrier, pc.coupling.mediator_dofs)
+        coarse = BlockFields(
+            "coarse",
+            self.coarse.mesh,
+            int(self.coarse.n_components),
+            {"alpha": 1.0 - fine_share / c_measure},
+        )
+        return FieldLayout([coarse, *blocks], multipliers)
+
+    def dofmap(self) -> DofMap:
+        """The dof layout of the coupled system: the coarse block, then one block per patch."""
+        return DofMap.of_models({name: self.model(name) for name in self._names})
+
+    def _dirichlet_rows(self, bc: _Dirichlet, dofmap: DofMap, k: int) -> LinearConstraint:
         model = self.model(bc.block)
         mesh = model.mesh
         nodes = np.nonzero(np.asarray(bc.where(mesh.p), dtype=bool))[0]
@@ -597,7 +313,8 @@ class ArlequinProblem:
         comps = list(range(d)) if bc.components is None else list(bc.components)
         if any(c < 0 or c >= d for c in comps):
             raise ValueError(f"Dirichlet components must lie in [0, {d}), got {comps}")
-        dofs = (nodes[None, :] * d + np.array(comps)[:, None]).T.ravel()
+        dofs = dofmap[bc.block].node_dofs(nodes, comps).T.ravel()
+        n = dofmap.n_dofs
         if callable(bc.value):
             vals = (
                 np.asarray(bc.value(mesh.p[:, nodes]), dtype=float).reshape(d, -1)[comps].T.ravel()
@@ -606,7 +323,7 @@ class ArlequinProblem:
             v = np.broadcast_to(np.asarray(bc.value, dtype=float).reshape(-1), (d,))
             vals = np.tile(v[comps], nodes.size)
         rows = sp.csr_matrix(
-            (np.ones(dofs.size), (np.arange(dofs.size), offset + dofs)), shape=(dofs.size, n)
+            (np.ones(dofs.size), (np.arange(dofs.size), dofs)), shape=(dofs.size, n)
         )
         rhs = (
             vals

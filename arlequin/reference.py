@@ -1,4 +1,4 @@
-"""First-order reference elements evaluated at arbitrary, per-point reference coordinates.
+"""First-order reference elements: the one table of supported cells, evaluated at any point.
 
 scikit-fem evaluates a basis at the *same* reference points in every cell. Transfer operators
 between non-matching meshes need the opposite: each physical point has its own cell and its own
@@ -49,6 +49,7 @@ __all__ = [
     "interpolation_matrix",
     "map_to_physical",
     "reference_element",
+    "scalar_element_for",
     "shape_functions",
     "shape_gradients",
 ]
@@ -168,6 +169,25 @@ def reference_element(mesh_or_type: Mesh | type[Mesh]) -> ReferenceElement:
     raise ValueError(
         f"mesh type {cls.__name__} is not supported; use a first-order MeshLine, MeshTri, "
         "MeshQuad, MeshTet or MeshHex"
+    )
+
+
+def scalar_element_for(mesh: Mesh):
+    """The first-order Lagrange element (P1 or Q1) of ``mesh``'s cell type, a new instance.
+
+    Raises
+    ------
+    ValueError
+        For any mesh type other than first-order lines, triangles, quadrilaterals, tetrahedra
+        and hexahedra.
+    """
+    cls = type(mesh)
+    for mesh_type, element, _ in _TABLE:
+        if issubclass(cls, mesh_type) and getattr(cls, "elem", None) is element:
+            return element()
+    raise ValueError(
+        f"mesh type {cls.__name__} is not supported; use a MeshLine, MeshTri, MeshQuad, "
+        "MeshTet or MeshHex (first order)"
     )
 
 

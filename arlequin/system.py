@@ -13,45 +13,22 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
+
+from .contract import Model, StateError
+from .dofs import DofMap
 
 __all__ = [
     "Block",
     "BlockTerm",
     "CoupledSystem",
     "LinearConstraint",
-    "Model",
-    "StateError",
+    "Model",  # re-exported from arlequin.contract
+    "StateError",  # re-exported from arlequin.contract
 ]
-
-
-class StateError(ValueError):
-    """A model's state became invalid during a run (an inverted cell, a failed return mapping).
-
-    Models raise subclasses of it from ``internal_force``; the integrators turn it into a
-    :class:`~arlequin.integrators.SimulationError` naming the step and the time, and keep what
-    was recorded until then.
-    """
-
-
-class Model(Protocol):
-    """What the core expects of a physics model (see ``arlequin.models``).
-
-    Every method takes an optional quadrature-point ``weight`` (the partition weight α).
-    """
-
-    n_dofs: int
-
-    def stiffness(self, weight=None) -> sp.spmatrix: ...
-
-    def mass(self, weight=None, lumped: bool = False): ...
-
-    def internal_force(self, u: np.ndarray, state=None, weight=None) -> tuple[np.ndarray, Any]: ...
-
-    def with_mesh(self, mesh) -> Model: ...
 
 
 @dataclass(frozen=True)
@@ -165,8 +142,11 @@ class CoupledSystem:
     ----------
     blocks : list of Block
     constraints : list of LinearConstraint
+        Equality rows (and unilateral constraint objects, see :mod:`arlequin.contract`).
     load : callable
         ``load(t) -> (n,)`` external force vector (N) at time t (s), already weighted.
+    dofmap : DofMap
+        The blocks' dof layout (set on construction).
     """
 
     blocks: list[Block]
@@ -174,15 +154,16 @@ class CoupledSystem:
     load: Callable[[float], np.ndarray] | None = None
 
     def __post_init__(self) -> None:
-        offset = 0
+        self.dofmap = DofMap(
+            (b.name, b.n_dofs, int(getattr(b.model, "n_components", 1))) for b in self.blocks
+        )
         for block in self.blocks:
-            block.offset = offset
-            offset += block.n_dofs
+            block.offset = self.dofmap[block.name].offset
         self._cache: dict[str, Any] = {}
 
     @property
     def n_dofs(self) -> int:
-        return sum(b.n_dofs for b in self.blocks)
+        return self.dofmap.n_dofs
 
     def block(self, name: str) -> Block:
         for b in self.blocks:
@@ -192,7 +173,7 @@ class CoupledSystem:
 
     def split(self, u: np.ndarray) -> dict[str, np.ndarray]:
         """Global vector -> {block name: block vector}."""
-        return {b.name: u[b.dofs] for b in self.blocks}
+        return self.dofmap.split(u)
 
     # ------------------------------------------------------------------ operators
     def block_stiffness(self, block: Block) -> sp.csr_matrix:

@@ -15,9 +15,9 @@ For each, in one process:
 * ``coupling``: ``ArlequinProblem(coarse, [Patch(fine, ...)]).couplings`` — builds the overlap,
   classifies the patch boundary, selects the gluing zone, evaluates the partition weights and
   assembles the coupling matrices (H1, coarse mediator, ramp weights). Phases are timed by
-  wrapping (at run time, without editing the library) ``arlequin.problem.build_overlap``,
+  wrapping (at run time, without editing the library) ``arlequin.gluing.build_overlap``,
   ``PatchCoupling._classify_boundary``, ``PatchCoupling._gluing_zone``,
-  ``PatchCoupling._evaluate_weights`` and ``arlequin.problem.coupling_matrices``; ``other`` is the
+  ``PatchCoupling._evaluate_weights`` and ``arlequin.gluing.coupling_matrices``; ``other`` is the
   rest of the constructor (mainly the integration model's basis).
 * ``skfem``: scikit-fem's own linear-elasticity assembly of the fine stiffness on the patch mesh
   (``Basis`` construction + ``asm(linear_elasticity)``), at scikit-fem's default quadrature and
@@ -64,7 +64,7 @@ import trimesh  # noqa: F401
 from skfem import Basis, ElementTetP1, ElementTriP1, ElementVector, MeshTet, MeshTri, asm
 from skfem.models.elasticity import lame_parameters, linear_elasticity
 
-import arlequin.problem as problem_module
+import arlequin.gluing as problem_module
 from arlequin.models import IsotropicElastic, LinearElastic
 from arlequin.patches import refine_region
 from arlequin.problem import ArlequinProblem, Patch, PatchCoupling

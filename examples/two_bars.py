@@ -11,7 +11,8 @@ import json
 import sys
 from pathlib import Path
 
-from arlequin.demos.two_bars import plot_two_bars, run_block_impact, run_two_bars, run_wall
+from arlequin.demos.block_impact import run_block_impact
+from arlequin.demos.two_bars import plot_two_bars, run_two_bars, run_wall
 
 DOCS = Path(__file__).resolve().parent.parent / "docs"
 

@@ -29,9 +29,15 @@ import scipy.sparse as sp
 from skfem import Basis, BilinearForm, ElementVector, FacetBasis, LinearForm, Mesh
 from skfem.helpers import dot, grad
 
-from arlequin.elements import scalar_element_for
+from arlequin.reference import scalar_element_for
 
-__all__ = ["KINDS", "IsotropicElastic", "LinearElastic", "scalar_element_for"]
+__all__ = [
+    "KINDS",
+    "IsotropicElastic",
+    "LinearElastic",
+    "element_critical_step",
+    "scalar_element_for",
+]
 
 KINDS = ("1d", "plane_strain", "plane_stress", "axisymmetric", "3d")
 
@@ -84,6 +90,9 @@ WeightLike = float | np.ndarray | Callable[[np.ndarray], np.ndarray] | None
 class LinearElastic:
     """Linear elastic model on one first-order mesh (P1 simplices, Q1 quads/hexes).
 
+    Implements :class:`arlequin.contract.Model` with the capabilities ``"tangent"`` (its
+    stiffness) and ``"critical_time_step"`` (the element eigenvalue bound).
+
     Parameters
     ----------
     mesh : skfem.Mesh
@@ -103,6 +112,9 @@ class LinearElastic:
     dof ``d * node + component``.
     """
 
+    #: The internal force is ``stiffness() @ u`` (see :class:`arlequin.contract.DynamicModel`).
+    is_linear = True
+
     def __init__(
         self,
         mesh: Mesh,
@@ -111,6 +123,13 @@ class LinearElastic:
         area: float = 1.0,
         intorder: int | None = None,
     ) -> None:
+        if not isinstance(mesh, Mesh):
+            raise ValueError(f"mesh must be a scikit-fem Mesh, got {type(mesh).__name__}")
+        if not isinstance(material, IsotropicElastic):
+            raise ValueError(
+                f"material must be an IsotropicElastic(young, poisson, density), got "
+                f"{type(material).__name__}"
+            )
         dim = mesh.dim()
         if kind is None:
             kind = {1: "1d", 2: "plane_strain", 3: "3d"}[dim]
@@ -265,6 +284,26 @@ class LinearElastic:
         """Internal force K(α) u (N) and the (unchanged) state, for the integrators."""
         return self.stiffness(weight) @ u, state
 
+    def tangent(self, u: np.ndarray, state=None, weight: WeightLike = None) -> sp.csr_matrix:
+        """Consistent tangent (N/m): the stiffness, whatever u (capability ``"tangent"``)."""
+        return self.stiffness(weight)
+
+    def initial_state(self, weight: WeightLike = None) -> None:
+        """No state at quadrature points."""
+        return None
+
+    def critical_time_step(self, u: np.ndarray | None = None, state=None) -> float:
+        """Lower bound (s) of the lumped-mass central-difference critical step of the model alone.
+
+        ``2 / max_e √λ_max(K_e, M_e)`` over the cells (element stiffness and row-sum lumped
+        element mass, weight 1): the assembled system's largest eigenvalue never exceeds the
+        largest element one (Irons' theorem), and supports only lower it. Small strain: the
+        same in every configuration (u is ignored). Capability ``"critical_time_step"``.
+        """
+        if getattr(self, "_critical_step", None) is None:
+            self._critical_step = element_critical_step(self, self.basis)
+        return self._critical_step
+
     def strain_energy(self, u: np.ndarray, weight: WeightLike = None) -> float:
         """Weighted strain energy ½ uᵀ K(α) u (J)."""
         return 0.5 * float(u @ (self.stiffness(weight) @ u))
@@ -376,3 +415,33 @@ def _vector_field(value, x: np.ndarray, dim: int) -> np.ndarray:
             raise ValueError(f"vector data must have {dim} components, got {vec.size}")
         out = vec.reshape((dim,) + (1,) * (x.ndim - 1))
     return np.ascontiguousarray(np.broadcast_to(out, x.shape))
+
+
+def element_critical_step(model: LinearElastic, basis: Basis, mass_basis: Basis | None = None):
+    """2 / √(max over cells of λ_max(K_e, M_e)) (s): the element bound of the critical step.
+
+    Parameters
+    ----------
+    model : LinearElastic
+        Material and kinematics (its stiffness and mass integrands; its own mesh is not used).
+    basis : skfem.Basis
+        Vector basis of the cells for the stiffness (e.g. on a deformed mesh).
+    mass_basis : skfem.Basis, optional
+        Vector basis for the row-sum lumped element masses (default ``basis``).
+    """
+    rho = model.material.density
+
+    @BilinearForm
+    def stiff(u, v, w):
+        return model._energy_density_form(u, v, w) * model._measure(w)
+
+    @BilinearForm
+    def mass(u, v, w):
+        return rho * dot(u, v) * model._measure(w)
+
+    k_e = stiff.elemental(basis).tolocal()  # (n_el, nd, nd)
+    m_e = mass.elemental(basis if mass_basis is None else mass_basis).tolocal().sum(axis=2)
+    d = 1.0 / np.sqrt(np.maximum(m_e, 1e-300))
+    scaled = k_e * d[:, :, None] * d[:, None, :]
+    top = float(np.max(np.linalg.eigvalsh(0.5 * (scaled + np.swapaxes(scaled, 1, 2)))[:, -1]))
+    return 2.0 / np.sqrt(top) if top > 0.0 else float("inf")

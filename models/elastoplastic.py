@@ -36,9 +36,9 @@ import numpy as np
 import scipy.sparse as sp
 from skfem import Basis, Mesh, MeshHex, MeshQuad
 
-from arlequin.system import StateError
+from arlequin.contract import StateError
 
-from .elastic import IsotropicElastic, LinearElastic, WeightLike
+from .elastic import IsotropicElastic, LinearElastic, WeightLike, element_critical_step
 
 __all__ = [
     "FiniteStrainJ2",
@@ -260,8 +260,9 @@ class FiniteStrainJ2:
     interleaved by node like :class:`~arlequin.models.LinearElastic`
     (``dim * node + component``), and :meth:`mass`, :meth:`stiffness` (small-strain elastic, for
     stable-step estimates) come from a :class:`~arlequin.models.LinearElastic` on the same mesh
-    and quadrature. There is no consistent tangent: the model is meant for explicit central
-    differences.
+    and quadrature. Capabilities (:mod:`arlequin.contract`): ``"critical_time_step"`` in the
+    current configuration; no ``"tangent"``: the model is meant for explicit central
+    differences (implicit schemes refuse it, or use ``newton="initial"``).
     """
 
     is_linear = False
@@ -474,6 +475,19 @@ class FiniteStrainJ2:
         K, G = self.material.bulk_modulus, self.material.shear_modulus
         psi = 0.5 * K * tr**2 + G * np.sum((eps - tr / 3.0) ** 2, axis=0)
         return float(np.sum(alpha * self._dv0 * psi))
+
+    def critical_time_step(self, u: np.ndarray, state: PlasticState | None = None) -> float:
+        """Element estimate (s) of the explicit critical step in the configuration X + u.
+
+        The element eigenvalue bound of :func:`~arlequin.models.elastic.element_critical_step`
+        with the small-strain elastic stiffness of the current cells and the reference lumped
+        masses (total Lagrangian): it follows cells that are crushed during a run. At u = 0 it
+        is a lower bound of the model's critical step. Capability ``"critical_time_step"``.
+        """
+        current = type(self.mesh)(self.current_coordinates(u), self.mesh.t)
+        # the elastic integrands (material and kinematics) on the current cells
+        basis = Basis(current, self.elastic.element, intorder=self.intorder)
+        return element_critical_step(self.elastic, basis, mass_basis=self.basis)
 
     def current_coordinates(self, u: np.ndarray) -> np.ndarray:
         """Node positions x = X + u, shape (dim, n_nodes) (m)."""

@@ -16,10 +16,10 @@ import numpy as np
 import pytest
 
 from arlequin.cli import main
+from arlequin.demos.block_impact import run_block_impact
 from arlequin.demos.two_bars import (
     JSON_KEYS,
     exact_two_bars,
-    run_block_impact,
     run_two_bars,
     run_wall,
 )

@@ -19,12 +19,15 @@ Two numbers are reported (fractions, see ``docs/theory.md``):
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 import skfem
 
 from ..integrators.static import solve_static
+from ..io import JsonResult, ResultsFolder, write_static
 from ..patches import refine_region
 from ..problem import ArlequinProblem, Patch
 
@@ -34,7 +37,7 @@ DIMS = ("1", "2", "3", "axi")
 
 
 @dataclass
-class PatchTestResult:
+class PatchTestResult(JsonResult):
     """Outcome of a patch test (all values dimensionless fractions or counts)."""
 
     max_error: float
@@ -50,9 +53,9 @@ class PatchTestResult:
     seed: int
     overlap_method: str
     exact_expected: bool
+    static: Any = field(default=None, repr=False, compare=False)
 
-    def to_json(self) -> dict:
-        return asdict(self)
+    json_exclude = ("static",)
 
     def summary(self) -> str:
         return (
@@ -257,6 +260,7 @@ def run_patch_test(
     mediator: str = "coarse",
     mesh: str = "nested",
     seed: int = 0,
+    out: str | Path | None = None,
 ) -> PatchTestResult:
     """Run one random patch test; see the module docstring.
 
@@ -268,7 +272,14 @@ def run_patch_test(
     mediator : {"coarse", "fine"}
     mesh : {"nested", "nonnested"}
     seed : int
+    out : path, optional
+        Results folder to write (:class:`arlequin.io.ResultsFolder`): results.json,
+        history.csv (the strain energies and the residual) and one frame per model (the
+        displacement, the weight alpha, the multiplier field).
     """
+    inputs = {"dim": str(dim), "coupling": coupling, "weights": weights, "mediator": mediator,
+              "mesh": mesh, "seed": seed}  # fmt: skip
+    folder = ResultsFolder(out, "arlequin patch-test", inputs) if out is not None else None
     problem, exact = build_patch_test_problem(dim, coupling, weights, mediator, mesh, seed)
     dim = str(dim)
     coarse_mesh = problem.coarse.mesh
@@ -283,7 +294,7 @@ def run_patch_test(
     lam = sp_sys.best_multipliers(u_full)
     residual = sp_sys.residual(u_full, lam)
     pc = problem.couplings[0]
-    return PatchTestResult(
+    out_result = PatchTestResult(
         max_error=float(max_error),
         exact_residual=float(residual),
         n_coarse_dofs=int(problem.coarse.n_dofs),
@@ -298,6 +309,15 @@ def run_patch_test(
         overlap_method=pc.overlap.method,
         exact_expected=exactness_expected(dim, weights, mediator, mesh),
     )
+    out_result.static = result
+    if folder is not None:
+        write_static(folder, result.system, result, problem.field_layout())
+        values = {k: v for k, v in out_result.to_json().items() if k not in inputs}
+        units = {"max_error": "1", "exact_residual": "1", "n_coarse_dofs": "1",
+                 "n_fine_dofs": "1", "n_multipliers": "1"}  # fmt: skip
+        folder.add_results(values, units)
+        folder.finish()
+    return out_result
 
 
 def _nodal(field, mesh) -> np.ndarray:

@@ -1,4 +1,4 @@
-"""Impact of two elastic bars (the seed's Figure 1), a bar against a rigid wall, and 2D/3D blocks.
+"""Impact of two elastic bars (the seed's Figure 1) and a bar against a rigid wall.
 
 Two bars (SI units): bar 1 on [−L1, 0] at velocity v₀, bar 2 on [0, L2] at velocity v₂ (default
 at rest), same material (E, ρ, c = √(E/ρ)), touching at t = 0. Exact solution for L1 = L2 = L:
@@ -19,16 +19,17 @@ Sign conventions: λ_v ≤ 0 is the normal contact pressure; reports give ``cont
 
 from __future__ import annotations
 
-import json
 import logging
 import math
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 import skfem
 
 from ..integrators import solve
+from ..io import DynamicRunWriter, ResultsFolder
 from ..models import (
     ContactSurface,
     DeformableContactPair,
@@ -40,14 +41,15 @@ from ..models import (
     SignoriniContact,
 )
 from ..system import Block, BlockTerm, CoupledSystem
+from .impact import JSON_KEYS, TwoBarsResult, exact_two_bars, impact_metrics
+from .plots import plot_two_bars
 
 __all__ = [
-    "BlockImpactResult",
+    "JSON_KEYS",
     "TwoBarsResult",
     "exact_two_bars",
     "impact_metrics",
     "plot_two_bars",
-    "run_block_impact",
     "run_two_bars",
     "run_wall",
 ]
@@ -55,154 +57,6 @@ __all__ = [
 logger = logging.getLogger(__name__)
 
 AREA = 1e-4  # bar cross-section (m²); the pressures do not depend on it
-JSON_KEYS = (
-    "t", "interface_velocity", "contact_pressure", "kinetic", "internal", "total_energy",
-    "contact_work", "final_velocities", "contact_duration", "dt", "fixed_point_iterations",
-)
-
-
-@dataclass
-class TwoBarsResult:
-    """Time histories of one impact run (SI units).
-
-    Attributes
-    ----------
-    t : ndarray, shape (n_rec,)
-        Times (s), from 0.
-    interface_velocity : ndarray, shape (n_rec,)
-        Velocity of bar 2's contact node (m/s) (the bar's for the wall).
-    contact_pressure : ndarray, shape (n_rec,)
-        −λ_v (Pa).
-    kinetic, internal, total_energy : ndarray, shape (n_rec,)
-        Kinetic, strain and their sum (J).
-    contact_work : ndarray, shape (n_rec,)
-        Accumulated work of the contact forces (J), from the multipliers (≤ 0: dissipated).
-    final_velocities : list of float
-        Mass-weighted mean velocities of the bars at the end (m/s).
-    contact_duration : float
-        (last − first record with λ_v ≠ 0) + Δt (s).
-    dt : float
-        Time step (s).
-    fixed_point_iterations : ndarray of int, shape (n_rec,)
-        Status iterations of the step ending at each record (0 at t = 0 for implicit schemes).
-    method : str
-        ``"levelset"``, ``"newmark-trapezoidal"`` or ``"newmark-hht"``.
-    exact : dict
-        Exact interface velocity (m/s), pressure (Pa), duration (s), final velocities (m/s).
-    newmark : TwoBarsResult or None
-        The baseline run of ``method="both"``.
-    """
-
-    t: np.ndarray
-    interface_velocity: np.ndarray
-    contact_pressure: np.ndarray
-    kinetic: np.ndarray
-    internal: np.ndarray
-    total_energy: np.ndarray
-    contact_work: np.ndarray
-    final_velocities: list[float]
-    contact_duration: float
-    dt: float
-    fixed_point_iterations: np.ndarray
-    method: str = "levelset"
-    integrator: str = "theta"
-    exact: dict[str, Any] = field(default_factory=dict)
-    config: dict[str, Any] = field(default_factory=dict)
-    n_status_failures: int = 0
-    newmark: TwoBarsResult | None = None
-
-    def to_json(self) -> dict[str, Any]:
-        """The JSON document of the CLI: exactly :data:`JSON_KEYS` (+ ``"newmark"``)."""
-        out: dict[str, Any] = {}
-        for k in JSON_KEYS:
-            val = getattr(self, k)
-            if isinstance(val, np.ndarray):
-                val = val.tolist()
-            elif isinstance(val, (list, tuple)):
-                val = [float(x) for x in val]
-            else:
-                val = float(val)
-            out[k] = val
-        if self.newmark is not None:
-            out["newmark"] = self.newmark.to_json()
-        return out
-
-    def dumps(self) -> str:
-        return json.dumps(self.to_json(), indent=2)
-
-    def metrics(self) -> dict[str, float]:
-        """The Must-show figures against :attr:`exact` (see :func:`impact_metrics`)."""
-        return impact_metrics(self)
-
-    def summary(self) -> str:
-        m = self.metrics()
-        text = (
-            f"{self.method} ({self.integrator}), dt = {self.dt:.4e} s: interface velocity rms "
-            f"error {m['velocity_rms_error']:.3e}, pressure rms error "
-            f"{m['pressure_rms_error']:.3e}, "
-            f"duration {self.contact_duration:.6e} s (exact {self.exact['duration']:.6e} s, "
-            f"{m['duration_error_steps']:+.2f} steps), final velocities "
-            f"{[round(v, 6) for v in self.final_velocities]}, energy lost {m['energy_loss']:.3e}"
-        )
-        if self.newmark is not None:
-            text += "\n" + self.newmark.summary()
-        return text
-
-
-def exact_two_bars(lengths=(1.0, 1.0), young=210e9, density=7850.0, velocity=1.0,
-                   velocity2=0.0) -> dict[str, Any]:
-    """Exact solution of the two-bar impact (same material, bars touching at t = 0).
-
-    Returns
-    -------
-    dict
-        ``interface_velocity`` (m/s), ``pressure`` (Pa), ``duration`` (s),
-        ``final_velocities`` (m/s, mass-weighted means), ``c`` (m/s).
-    """
-    c = math.sqrt(young / density)
-    l1, l2 = (float(x) for x in lengths)
-    lmin = min(l1, l2)
-    dv = velocity - velocity2
-    # impulse per unit area: ρ c dv/2 during 2 L_min / c -> ρ L_min dv
-    return {
-        "interface_velocity": 0.5 * (velocity + velocity2),
-        "pressure": 0.5 * density * c * dv,
-        "duration": 2.0 * lmin / c,
-        "final_velocities": [velocity - lmin * dv / l1, velocity2 + lmin * dv / l2],
-        "c": c,
-    }
-
-
-def impact_metrics(result: TwoBarsResult, skip: int = 2) -> dict[str, float]:
-    """Errors of an impact run against its exact solution.
-
-    Over the records in contact (λ_v ≠ 0) except the first ``skip`` and the last ``skip``:
-    rms of (interface velocity − exact)/|exact| and of (pressure − exact)/exact. Also the
-    duration error in steps, the final-velocity error / v₀, and the energy lost
-    (E(0) − E(end))/E(0).
-    """
-    ex = result.exact
-    act = np.nonzero(result.contact_pressure != 0.0)[0]
-    out = {"velocity_rms_error": math.nan, "pressure_rms_error": math.nan}
-    if act.size > 2 * skip:
-        sl = slice(act[0] + skip, act[-1] - skip + 1)
-        vi = result.interface_velocity[sl]
-        pr = result.contact_pressure[sl]
-        vref = ex["interface_velocity"]
-        scale_v = abs(vref) if vref != 0.0 else abs(ex["velocity_scale"])
-        out["velocity_rms_error"] = float(np.sqrt(np.mean((vi - vref) ** 2)) / scale_v)
-        p_err = np.sqrt(np.mean((pr - ex["pressure"]) ** 2))
-        out["pressure_rms_error"] = float(p_err / ex["pressure"])
-    out["duration_error_steps"] = (result.contact_duration - ex["duration"]) / result.dt
-    fin = np.asarray(result.final_velocities) - np.asarray(ex["final_velocities"])
-    out["final_velocity_error"] = float(np.max(np.abs(fin)) / abs(ex["velocity_scale"]))
-    e = result.total_energy
-    out["energy_loss"] = float((e[0] - e[-1]) / e[0])
-    out["max_energy_gain"] = float((np.max(e) - e[0]) / e[0])
-    w = result.contact_work
-    out["contact_work"] = float(w[-1])
-    out["balance_error"] = float(np.max(np.abs(e - e[0] - w)) / e[0])
-    return out
 
 
 # ---------------------------------------------------------------------------------------------
@@ -235,46 +89,75 @@ def _integrator_options(
     raise ValueError(f"newmark must be 'trapezoidal' or 'hht', got {newmark!r}")
 
 
+@dataclass
+class _Impact:
+    """A 1D impact set-up: the bars, their initial velocities, the contact pair, the step."""
+
+    bodies: list[LinearElastic]
+    names: list[str]
+    v_init: list[float]
+    pair_factory: Any  # DofMap -> ContactPair
+    interface_dof: Any  # DofMap -> global dof of the reported interface velocity
+    exact: dict[str, Any]
+    config: dict[str, Any]
+    material: IsotropicElastic
+    dt: float
+    t_end: float
+
+
+@dataclass(frozen=True)
+class _Scheme:
+    """The method and time scheme of one run."""
+
+    method: str  # "levelset" or "newmark"
+    newmark: str
+    integrator: str
+    theta: float
+
+
 def _run_1d(
-    bodies: list[LinearElastic],
-    names: list[str],
-    v_init: list[float],
-    pair_factory,
-    method: str,
-    newmark: str,
-    integrator: str,
-    theta: float,
-    dt: float,
-    t_end: float,
-    interface_dof,
-    exact: dict[str, Any],
-    config: dict[str, Any],
-    material: IsotropicElastic,
+    setup: _Impact, scheme: _Scheme, folder: ResultsFolder | None = None, prefix: str = ""
 ) -> TwoBarsResult:
+    bodies, names = setup.bodies, setup.names
+    method, newmark, integrator, theta = (
+        scheme.method, scheme.newmark, scheme.integrator, scheme.theta
+    )  # fmt: skip
+    dt, t_end, material = setup.dt, setup.t_end, setup.material
     system = CoupledSystem([Block(n, b, [BlockTerm(b)]) for n, b in zip(names, bodies)])
-    v0 = {n: np.full(b.n_dofs, v) for n, b, v in zip(names, bodies, v_init)}
-    pair = pair_factory(system)
+    v0 = {n: np.full(b.n_dofs, v) for n, b, v in zip(names, bodies, setup.v_init)}
+    pair = setup.pair_factory(system.dofmap)
     kind = "levelset" if method == "levelset" else "signorini"
     con = _contact(kind, pair, material)
     integ, opts = _integrator_options(method, newmark, integrator, theta)
     if integ == "explicit":
         opts["safety"] = 1.0
-    res = solve(system, integ, t_end=t_end, dt=dt, v0=v0, constraints=[con], save_fields=True,
-                **opts)
+    meth = "levelset" if method == "levelset" else f"newmark-{newmark}"
+    writers = []
+    if folder is not None:
+        frames = np.linspace(0.0, t_end, 61)
+        writers.append(DynamicRunWriter(folder, system, frame_times=frames, prefix=prefix))
+    res = solve(
+        system,
+        integ,
+        t_end=t_end,
+        dt=dt,
+        v0=v0,
+        constraints=[con],
+        save_fields=True,
+        on_record=writers,
+        **opts,
+    )
     if res.n_status_failures:
-        logger.warning("%s: %d steps reached the status iteration cap", method,
-                       res.n_status_failures)
+        logger.warning(
+            "%s: %d steps reached the status iteration cap", method, res.n_status_failures
+        )
     t = res.times
     lam = res.multipliers[con.name][:, 0]
     pressure = -lam
     kin = res.total_kinetic
     strain = res.total_strain
-    hist = con.history
-    work = hist.work
-    if work.size == t.size - 1:
-        work = np.concatenate([[0.0], work])
-    elif work.size != t.size:
-        work = np.interp(t, hist.t, hist.work, left=0.0)
+    # the history has one record per step (times[1:]); no work is done before the first step
+    work = np.concatenate([[0.0], con.history(res).work])
     act = np.nonzero(lam != 0.0)[0]
     duration = float(t[act[-1]] - t[act[0]] + res.dt) if act.size else 0.0
     finals = []
@@ -286,10 +169,9 @@ def _run_1d(
             finals.append(float(np.asarray(mb.sum(axis=1)).ravel() @ vb / mb.sum()))
         else:
             finals.append(float(np.ones(b.n_dofs) @ (mb @ vb) / mb.sum()))
-    meth = "levelset" if method == "levelset" else f"newmark-{newmark}"
     return TwoBarsResult(
         t=t,
-        interface_velocity=res.fields["v"][:, interface_dof(system)],
+        interface_velocity=res.fields["v"][:, setup.interface_dof(system.dofmap)],
         contact_pressure=pressure,
         kinetic=kin,
         internal=strain,
@@ -301,9 +183,10 @@ def _run_1d(
         fixed_point_iterations=res.status_iterations.astype(int),
         method=meth,
         integrator=integ,
-        exact=exact,
-        config=config,
+        exact=setup.exact,
+        config=setup.config,
         n_status_failures=int(res.n_status_failures),
+        dynamic=res,
     )
 
 
@@ -320,6 +203,7 @@ def run_two_bars(
     theta: float = 0.5,
     t_end: float | None = None,
     integrator: str = "theta",
+    out: str | Path | None = None,
 ) -> TwoBarsResult:
     """Impact of two bars touching at t = 0 (see the module docstring).
 
@@ -346,6 +230,10 @@ def run_two_bars(
     integrator : {"theta", "explicit"}
         Time scheme of the level-set method (the θ-scheme with consistent mass, or central
         differences with lumped mass).
+    out : path, optional
+        Results folder (:class:`arlequin.io.ResultsFolder`): results.json, history.csv and
+        one field series per bar (the Newmark baseline of ``method="both"`` in files prefixed
+        ``newmark-trapezoidal_`` or ``newmark-hht_``), two_bars.png.
 
     Returns
     -------
@@ -371,29 +259,55 @@ def run_two_bars(
     t_end = 3.0 * max(l1, l2) / c if t_end is None else float(t_end)
     bar1 = _bar(-l1, 0.0, n, material)
     bar2 = _bar(0.0, l2, n, material)
-    config = {"lengths": [l1, l2], "young": young, "density": density, "velocity": velocity,
-              "velocity2": velocity2, "elements": n, "cfl": cfl, "theta": theta, "t_end": t_end}
+    config = {
+        "lengths": [l1, l2],
+        "young": young,
+        "density": density,
+        "velocity": velocity,
+        "velocity2": velocity2,
+        "elements": n,
+        "cfl": cfl,
+        "theta": theta,
+        "t_end": t_end,
+    }
 
-    def pair_factory(system):
-        s = ContactSurface(bar1.mesh, where=lambda x: x[0] > -0.5 * l1,
-                           offset=system.block("bar1").offset, area=AREA)
-        m = ContactSurface(bar2.mesh, where=lambda x: x[0] < 0.5 * l2,
-                           offset=system.block("bar2").offset, area=AREA)
-        return DeformableContactPair(s, m, system.n_dofs)
+    def pair_factory(dofmap):
+        s = ContactSurface(
+            bar1.mesh, where=lambda x: x[0] > -0.5 * l1, offset=dofmap["bar1"], area=AREA
+        )
+        m = ContactSurface(
+            bar2.mesh, where=lambda x: x[0] < 0.5 * l2, offset=dofmap["bar2"], area=AREA
+        )
+        return DeformableContactPair(s, m, dofmap)
 
-    def interface_dof(system):
-        return system.block("bar2").offset + int(np.argmin(bar2.mesh.p[0]))
+    def interface_dof(dofmap):
+        return int(dofmap["bar2"].node_dofs([np.argmin(bar2.mesh.p[0])])[0, 0])
 
-    def one(meth: str) -> TwoBarsResult:
-        return _run_1d([bar1, bar2], ["bar1", "bar2"], [velocity, velocity2], pair_factory, meth,
-                       newmark, integrator, theta, dt, t_end, interface_dof, ex,
-                       dict(config, method=meth), material)
+    def one(meth: str, prefix: str = "") -> TwoBarsResult:
+        setup = _Impact(
+            [bar1, bar2],
+            ["bar1", "bar2"],
+            [velocity, velocity2],
+            pair_factory,
+            interface_dof,
+            ex,
+            dict(config, method=meth),
+            material,
+            dt,
+            t_end,
+        )
+        return _run_1d(setup, _Scheme(meth, newmark, integrator, theta), folder, prefix)
 
+    folder = _folder(out, "arlequin two-bars", dict(config, method=method, newmark=newmark,
+                                                      integrator=integrator))  # fmt: skip
     if method == "both":
         res = one("levelset")
-        res.newmark = one("newmark")
-        return res
-    return one(method)
+        # the baseline's files are prefixed (newmark-trapezoidal_history.csv...)
+        res.newmark = one("newmark", f"newmark-{newmark}_")
+    else:
+        res = one(method)
+    _finish(folder, res)
+    return res
 
 
 def run_wall(
@@ -408,6 +322,7 @@ def run_wall(
     theta: float = 0.5,
     t_end: float | None = None,
     integrator: str = "theta",
+    out: str | Path | None = None,
 ) -> TwoBarsResult:
     """A bar on [−L, 0] at velocity v₀ > 0 against a rigid wall at x = 0 (touching at t = 0).
 
@@ -427,248 +342,69 @@ def run_wall(
     dt = cfl * L / n / c
     t_end = 3.0 * L / c if t_end is None else float(t_end)
     bar = _bar(-L, 0.0, n, material)
-    ex = {"interface_velocity": 0.0, "pressure": density * c * velocity, "duration": 2.0 * L / c,
-          "final_velocities": [-velocity], "c": c, "velocity_scale": velocity}
-    config = {"length": L, "young": young, "density": density, "velocity": velocity, "elements": n,
-              "cfl": cfl, "theta": theta, "t_end": t_end, "method": method}
+    ex = {
+        "interface_velocity": 0.0,
+        "pressure": density * c * velocity,
+        "duration": 2.0 * L / c,
+        "final_velocities": [-velocity],
+        "c": c,
+        "velocity_scale": velocity,
+    }
+    config = {
+        "length": L,
+        "young": young,
+        "density": density,
+        "velocity": velocity,
+        "elements": n,
+        "cfl": cfl,
+        "theta": theta,
+        "t_end": t_end,
+        "method": method,
+    }
 
-    def pair_factory(system):
-        s = ContactSurface(bar.mesh, where=lambda x: x[0] > -0.5 * L, offset=0, area=AREA)
-        return RigidContactPair(s, PlaneObstacle([0.0], [-1.0]), system.n_dofs)
+    def pair_factory(dofmap):
+        s = ContactSurface(
+            bar.mesh, where=lambda x: x[0] > -0.5 * L, offset=dofmap["bar"], area=AREA
+        )
+        return RigidContactPair(s, PlaneObstacle([0.0], [-1.0]), dofmap)
 
-    def interface_dof(system):
-        return int(np.argmax(bar.mesh.p[0]))
+    def interface_dof(dofmap):
+        return int(dofmap["bar"].node_dofs([np.argmax(bar.mesh.p[0])])[0, 0])
 
-    return _run_1d([bar], ["bar"], [velocity], pair_factory, method, newmark, integrator, theta, dt,
-                   t_end, interface_dof, ex, config, material)
-
-
-# ---------------------------------------------------------------------------------------------
-# 2D / 3D blocks
-# ---------------------------------------------------------------------------------------------
-@dataclass
-class BlockImpactResult:
-    """A block launched onto a rigid plane or onto an identical block at rest (SI units).
-
-    Attributes
-    ----------
-    dim : int
-    target : str
-        ``"plane"`` or ``"block"``.
-    elements : int
-        Elements in the impact direction.
-    dt : float
-        Time step (s); h the element size (m).
-    h : float
-    t : ndarray, shape (n_rec,)
-    total_energy : ndarray, shape (n_rec,)
-        Kinetic + strain (J).
-    contact_work : ndarray, shape (n_rec,)
-        Accumulated contact work (J).
-    first_contact, separation : int
-        Record indices: the first record with λ ≠ 0 and the first record after the last one
-        with λ ≠ 0.
-    energy_loss : float
-        (E(first contact − 1) − E(separation)) / E(0).
-    max_gap_drift : float
-        max over active points and steps of |d_n(t) − d_n(t_activation)| (m).
-    max_penetration_excess : float
-        max over activations of d_n(t_act) − (1 − θ)Δt[[v_n]]⁻ (m) (≤ 0 means within the bound).
-    max_penetration : float
-        Largest d_n at activation (m).
-    iterations : ndarray of int
-        Fixed-point iterations of every step.
-    iterations_contact : ndarray of int
-        Those of the steps with an active point.
-    n_status_failures : int
-    final_velocities : list of float
-        Mean velocity (impact component) of each body at the end (m/s).
-    """
-
-    dim: int
-    target: str
-    elements: int
-    dt: float
-    h: float
-    t: np.ndarray
-    total_energy: np.ndarray
-    contact_work: np.ndarray
-    first_contact: int
-    separation: int
-    energy_loss: float
-    max_gap_drift: float
-    max_penetration_excess: float
-    max_penetration: float
-    iterations: np.ndarray
-    iterations_contact: np.ndarray
-    n_status_failures: int
-    final_velocities: list[float]
-    theta: float = 0.5
-
-    def to_json(self) -> dict[str, Any]:
-        d = asdict(self)
-        return {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in d.items()}
-
-    def iteration_distribution(self) -> dict[int, int]:
-        """{iterations: number of steps} over the steps with contact."""
-        vals, counts = np.unique(self.iterations_contact, return_counts=True)
-        return {int(v): int(c) for v, c in zip(vals, counts)}
-
-
-def run_block_impact(
-    dim: int = 2,
-    target: str = "plane",
-    elements: int = 20,
-    velocity: float = 1.0,
-    young: float = 210e9,
-    poisson: float = 0.3,
-    density: float = 7850.0,
-    height: float = 0.1,
-    aspect: float = 0.25,
-    theta: float = 0.5,
-    cfl: float = 1.0,
-    gap_steps: float = 2.3,
-    t_end: float | None = None,
-    integrator: str = "theta",
-) -> BlockImpactResult:
-    """A block launched at v₀ onto a rigid plane or onto an identical block at rest, no gravity.
-
-    The block (height H in the impact direction, the last coordinate; width aspect·H) has
-    ``elements`` elements along H and ``round(aspect·elements)`` (≥ 2) across; plane strain in
-    2D (MeshQuad), hexahedra in 3D. It starts at a gap of ``gap_steps`` v₀Δt (so that the
-    activation falls inside a step) and moves at −v₀. Δt = cfl·h/c_d (dilatational speed).
-
-    Returns
-    -------
-    BlockImpactResult
-    """
-    if dim not in (2, 3):
-        raise ValueError(f"dim must be 2 or 3, got {dim}")
-    if target not in ("plane", "block"):
-        raise ValueError(f"target must be 'plane' or 'block', got {target!r}")
-    material = IsotropicElastic(young, poisson, density)
-    ne = int(elements)
-    nw = max(2, round(aspect * ne))
-    H = float(height)
-    W = aspect * H
-    h = H / ne
-    c_d = math.sqrt(material.young * (1 - poisson) / ((1 + poisson) * (1 - 2 * poisson)) / density)
-    dt = cfl * h / c_d
-    g0 = gap_steps * velocity * dt
-    lateral = [np.linspace(0.0, W, nw + 1)] * (dim - 1)
-
-    def make(z0: float) -> LinearElastic:
-        z = np.linspace(z0, z0 + H, ne + 1)
-        mesh = (skfem.MeshQuad if dim == 2 else skfem.MeshHex).init_tensor(*lateral, z)
-        return LinearElastic(mesh, material, kind="plane_strain" if dim == 2 else "3d")
-
-    top = make(g0)
-    bodies = [top]
-    names = ["block"]
-    if target == "block":
-        bodies.append(make(-H))
-        names.append("target")
-    system = CoupledSystem([Block(n, b, [BlockTerm(b)]) for n, b in zip(names, bodies)])
-    slave = ContactSurface(top.mesh, where=lambda x: x[-1] < g0 + 0.25 * h, offset=0)
-    if target == "plane":
-        pair = RigidContactPair(slave, PlaneObstacle(np.zeros(dim), np.eye(dim)[-1]), system.n_dofs)
-    else:
-        master = ContactSurface(bodies[1].mesh, where=lambda x: x[-1] > -0.25 * h,
-                                offset=system.block("target").offset)
-        pair = DeformableContactPair(slave, master, system.n_dofs)
-    con = LevelSetContact(pair, material=material)
-    v0 = np.zeros(system.n_dofs)
-    v0[system.block("block").dofs][dim - 1 :: dim] = -velocity  # a view: sets the block's dofs
-    c_bar = math.sqrt(young / density)
-    t_end = g0 / velocity + 3.0 * H / c_bar if t_end is None else float(t_end)
-    if integrator == "theta":
-        integ, opts = "theta", {"theta": theta}
-    else:
-        integ, opts = "explicit", {"safety": 1.0}
-    res = solve(system, integ, t_end=t_end, dt=dt, v0=v0, constraints=[con], **opts)
-    hist = con.history
-    e = res.total_energy
-    work = hist.work if hist.work.size == e.size else np.concatenate([[0.0], hist.work])
-    lam = res.multipliers[con.name]
-    in_contact = np.any(lam != 0.0, axis=1)
-    idx = np.nonzero(in_contact)[0]
-    first, last = (int(idx[0]), int(idx[-1])) if idx.size else (0, 0)
-    sep = min(last + 1, e.size - 1)
-    loss = float((e[max(first - 1, 0)] - e[sep]) / e[0])
-    # gap drift of active points and penetration at activation (history is per step)
-    act = hist.active
-    gap = hist.gap
-    prev = np.vstack([np.zeros((1, act.shape[1]), dtype=bool), act[:-1]])
-    newly = act & ~prev
-    ref_gap = np.full(act.shape[1], np.nan)
-    drift = 0.0
-    pen_excess = -np.inf
-    pen_max = -np.inf
-    for k in range(act.shape[0]):
-        nk = newly[k]
-        if np.any(nk):
-            ref_gap[nk] = gap[k, nk]
-            bound = (1.0 - theta) * hist.dt[k] * hist.vn_start[k, nk]
-            pen_excess = max(pen_excess, float(np.max(gap[k, nk] - bound)))
-            pen_max = max(pen_max, float(np.max(gap[k, nk])))
-        ak = act[k] & ~nk
-        if np.any(ak):
-            drift = max(drift, float(np.max(np.abs(gap[k, ak] - ref_gap[ak]))))
-    iters = hist.iterations.astype(int)
-    iters_contact = iters[np.any(act, axis=1)]
-    finals = []
-    for b in system.blocks:
-        vz = res.v[b.dofs][dim - 1 :: dim]
-        finals.append(float(np.mean(vz)))
-    return BlockImpactResult(
-        dim=dim, target=target, elements=ne, dt=float(res.dt), h=h, t=res.times, total_energy=e,
-        contact_work=work, first_contact=first, separation=sep, energy_loss=loss,
-        max_gap_drift=drift, max_penetration_excess=pen_excess, max_penetration=pen_max,
-        iterations=iters, iterations_contact=iters_contact,
-        n_status_failures=int(res.n_status_failures), final_velocities=finals, theta=theta,
+    folder = _folder(out, "arlequin two-bars --wall", dict(config, newmark=newmark,
+                                                             integrator=integrator))  # fmt: skip
+    setup = _Impact(
+        [bar], ["bar"], [velocity], pair_factory, interface_dof, ex, config, material, dt, t_end
     )
+    res = _run_1d(setup, _Scheme(method, newmark, integrator, theta), folder)
+    _finish(folder, res)
+    return res
 
 
-# ---------------------------------------------------------------------------------------------
-# plot
-# ---------------------------------------------------------------------------------------------
-def plot_two_bars(result: TwoBarsResult, path: str) -> None:
-    """Interface velocity and contact pressure against time, with the exact solution (PNG).
+_UNITS = {"lengths": "m", "length": "m", "young": "Pa", "density": "kg/m^3", "velocity": "m/s",
+          "velocity2": "m/s", "elements": "1", "cfl": "1", "theta": "1", "t_end": "s",
+          "method": "", "newmark": "", "integrator": ""}  # fmt: skip
+_RESULT_UNITS = {"velocity_rms_error": "1", "pressure_rms_error": "1", "duration_error_steps": "1",
+                 "final_velocity_error": "1", "energy_loss": "1", "max_energy_gain": "1",
+                 "contact_work": "J", "balance_error": "1", "contact_duration": "s", "dt": "s",
+                 "final_velocities": "m/s"}  # fmt: skip
 
-    With a ``result.newmark`` both methods are overlaid (the paper's Figure 1).
-    """
-    import matplotlib
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+def _folder(out, command: str, config: dict[str, Any]) -> ResultsFolder | None:
+    return None if out is None else ResultsFolder(out, command, config, _UNITS)
 
-    ex = result.exact
-    fig, axes = plt.subplots(2, 1, figsize=(8, 6.5), sharex=True)
-    t_exact = np.array([0.0, 0.0, ex["duration"], ex["duration"], result.t[-1]])
-    v_after = ex["final_velocities"][-1]
-    v_exact = np.array([ex["interface_velocity"]] * 3 + [v_after, v_after])
-    v_exact[0] = result.interface_velocity[0]
-    p_exact = np.array([0.0, ex["pressure"], ex["pressure"], 0.0, 0.0])
-    runs = [result] + ([result.newmark] if result.newmark is not None else [])
-    styles = {"levelset": ("C0", "-"), "newmark-trapezoidal": ("C3", "-"),
-              "newmark-hht": ("C1", "-")}
-    for r in runs:
-        col, ls = styles.get(r.method, ("C2", "-"))
-        axes[0].plot(r.t * 1e6, r.interface_velocity, color=col, ls=ls, lw=1.0, label=r.method)
-        axes[1].plot(r.t * 1e6, r.contact_pressure / 1e6, color=col, ls=ls, lw=1.0, label=r.method)
-    axes[0].plot(t_exact * 1e6, v_exact, "k--", lw=1.2, label="exact")
-    axes[1].plot(t_exact * 1e6, p_exact / 1e6, "k--", lw=1.2, label="exact")
-    axes[0].set_ylabel("interface velocity (m/s)")
-    axes[1].set_ylabel("contact pressure (MPa)")
-    axes[1].set_xlabel("time (µs)")
-    for ax in axes:
-        ax.grid(alpha=0.3)
-        ax.legend(loc="best", fontsize=8)
-    cfg = result.config
-    fig.suptitle(
-        f"two-bar impact: {cfg.get('elements')} elements per bar, CFL {cfg.get('cfl')}, "
-        f"v0 = {cfg.get('velocity')} m/s"
-    )
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+
+def _finish(folder: ResultsFolder | None, res: TwoBarsResult) -> None:
+    """Results of every run (``newmark-*`` prefixed for the baseline) and the picture."""
+    if folder is None:
+        return
+    for r in [res] + ([res.newmark] if res.newmark is not None else []):
+        vals = {**r.metrics(), "contact_duration": r.contact_duration, "dt": r.dt,
+                "final_velocities": r.final_velocities}  # fmt: skip
+        prefix = "" if r is res else f"{r.method}:"
+        folder.add_results(
+            {prefix + k: v for k, v in vals.items()},
+            {prefix + k: u for k, u in _RESULT_UNITS.items()},
+        )
+    plot_two_bars(res, str(folder.picture("two_bars")))
+    folder.finish()

@@ -27,18 +27,28 @@ of the coupled run (E the α-weighted kinetic plus strain energy).
 
 from __future__ import annotations
 
-import json
 import logging
 import math
 from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 import skfem
 
-from ..integrators import DEFAULT_SAFETY, CentralDifference, get_integrator, solve, stable_time_step
+from ..integrators import (
+    DEFAULT_SAFETY,
+    CentralDifference,
+    check_time_step,
+    get_integrator,
+    solve,
+    stable_time_step,
+)
+from ..io import DynamicRunWriter, JsonResult, ResultsFolder
 from ..models import IsotropicElastic, LinearElastic
 from ..problem import ArlequinProblem, Patch
 from ..system import Block, BlockTerm, CoupledSystem
+from .plots import plot_wave
 
 __all__ = ["INTEGRATORS", "WaveResult", "plot_wave", "run_wave", "wave_layout"]
 
@@ -55,7 +65,7 @@ AMPLITUDE = 1e-6  # m
 
 
 @dataclass
-class WaveResult:
+class WaveResult(JsonResult):
     """Result of :func:`run_wave` (fractions are dimensionless, dt in s).
 
     ``to_json()`` gives the five keys of the CLI's JSON output.
@@ -71,19 +81,15 @@ class WaveResult:
     multiplier_max: float = 0.0
     coupling_work_max: float = 0.0
     fields: dict = field(default_factory=dict, repr=False)
+    dynamic: Any = field(default=None, repr=False)
 
-    def to_json(self) -> dict:
-        keys = (
-            "reflected_energy_fraction",
-            "transmitted_energy_fraction",
-            "energy_drift",
-            "dt",
-            "n_steps",
-        )
-        return {k: getattr(self, k) for k in keys}
-
-    def dumps(self) -> str:
-        return json.dumps(self.to_json(), indent=2)
+    json_keys = (
+        "reflected_energy_fraction",
+        "transmitted_energy_fraction",
+        "energy_drift",
+        "dt",
+        "n_steps",
+    )
 
     def summary(self) -> str:
         c = self.config
@@ -153,6 +159,7 @@ def run_wave(
     dt: float | None = None,
     epsilon: float = 1e-3,
     length: float | None = None,
+    out: str | Path | None = None,
 ) -> WaveResult:
     """Run the 1D wave demo (see the module docstring).
 
@@ -176,6 +183,12 @@ def run_wave(
     length : float, optional
         H1 coupling length ℓ in coarse elements; default: the problem's default (the mean
         coarse cell size on the gluing band, i.e. one coarse element here).
+    out : path, optional
+        Results folder to write (:class:`arlequin.io.ResultsFolder`): results.json,
+        history.csv of the coupled run (energies and works per model, every step), its field
+        series (51 frames: displacement, velocity, alpha, the multiplier field) and wave.png.
+        The result then keeps the coupled run's :class:`~arlequin.integrators.DynamicResult`
+        with its fields (``result.dynamic``).
 
     Returns
     -------
@@ -191,6 +204,12 @@ def run_wave(
         )
     name = INTEGRATORS.get(integrator, integrator)
     cls = get_integrator(name)
+    inputs = {"ratio": ratio, "pulse_width": pulse_width, "gluing_width": gluing_width,
+              "coupling": coupling, "mediator": mediator, "weights": weights,
+              "integrator": integrator, "dt": dt, "epsilon": epsilon, "length": length}  # fmt: skip
+    units = {"ratio": "1", "pulse_width": "coarse elements", "gluing_width": "coarse elements",
+             "dt": "s", "epsilon": "1", "length": "coarse elements"}  # fmt: skip
+    folder = ResultsFolder(out, "arlequin wave", inputs, units) if out is not None else None
     lay = wave_layout(pulse_width, gluing_width)
     n_c = round(lay["length"])
     n_patch = round(lay["length"] - lay["x_patch"])
@@ -220,16 +239,18 @@ def run_wave(
     stable = stable_time_step(system)
     if dt is None:
         dt = DEFAULT_SAFETY * stable.critical
-    elif dt > stable.critical * (1.0 + 1e-12):
-        raise ValueError(
-            f"time step dt={dt:.6e} s exceeds the critical step of the coupled explicit system, "
-            f"{stable.critical:.6e} s (per-model bound {stable.block_bound:.6e} s)"
-        )
+    else:
+        check_time_step(dt, stable)
     t_m = lay["travel"] * H / c
     n_steps = math.ceil(t_m / dt)
     lumped = bool(cls.lumped_default)
     opts = {"check_dt": False} if issubclass(cls, CentralDifference) else {}
-    res = solve(system, name, n_steps=n_steps, dt=dt, u0=u0, v0=v0, **opts)
+    writers = []
+    if folder is not None:
+        frames = np.linspace(0.0, n_steps * dt, 51)
+        writers.append(DynamicRunWriter(folder, system, problem.field_layout(), frames))
+    res = solve(system, name, n_steps=n_steps, dt=dt, u0=u0, v0=v0, on_record=writers,
+                save_fields=folder is not None, **opts)  # fmt: skip
     # reference: the coarse model alone, same pulse, integrator and dt
     ref_system = CoupledSystem([Block("coarse", cm, [BlockTerm(cm)])])
     ref = solve(
@@ -295,52 +316,17 @@ def run_wave(
         multiplier_max=float(max(mult)) if mult else 0.0,
         coupling_work_max=float(np.max(np.abs(res.coupling_work["coarse"]))),
         fields=fields,
+        dynamic=res if folder is not None else None,
     )
     logger.info(out.summary())
+    if folder is not None:
+        folder.add_results(
+            {**out.to_json(), "incident_energy": e0, "multiplier_max": out.multiplier_max,
+             "coupling_work_max": out.coupling_work_max},
+            {"reflected_energy_fraction": "1", "transmitted_energy_fraction": "1",
+             "energy_drift": "1", "dt": "s", "n_steps": "1", "incident_energy": "J",
+             "multiplier_max": "N/m", "coupling_work_max": "J"},
+        )  # fmt: skip
+        plot_wave(out, str(folder.picture("wave")))
+        folder.finish()
     return out
-
-
-def plot_wave(result: WaveResult, path: str) -> None:
-    """PNG of the snapshot: coupled coarse and fine fields, the single-mesh reference, and the
-    reflected wave (their difference in the coarse-only region, magnified)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    f = result.fields
-    fig, (ax1, ax2, ax3) = plt.subplots(3, 1, figsize=(8, 7.5))
-    for ax in (ax1, ax2):
-        ax.axvspan(f["x_patch"], f["band_end"], color="0.9", label="gluing band")
-    ax1.plot(f["x_coarse"], f["u0_coarse"], "k:", lw=1, label="initial pulse")
-    ax1.plot(f["x_coarse"], f["u_reference"], "C2-", lw=1, label="single coarse mesh")
-    ax1.plot(f["x_coarse"], f["u_coarse"], "C0o-", ms=2, lw=1, label="coupled: coarse")
-    ax1.plot(f["x_fine"], f["u_fine"], "C1-", lw=1, label="coupled: fine patch")
-    ax1.set_ylabel("u (m)")
-    ax1.legend(fontsize=7)
-    c = result.config
-    ax1.set_title(
-        f"ratio {c['ratio']}, W = {c['pulse_width']}, G = {c['gluing_width']}, "
-        f"{c['coupling']}, {c['mediator']} mediator, {c['weights']}, {c['integrator']}"
-    )
-    only = f["x_coarse"] <= f["x_patch"] + 1e-12
-    diff = f["u_coarse"] - f["u_reference"]
-    ax2.plot(
-        f["x_coarse"][only],
-        diff[only],
-        "C3o-",
-        ms=2,
-        lw=1,
-        label=f"reflected wave (reflected energy fraction {result.reflected_energy_fraction:.2e})",
-    )
-    ax2.set_ylabel("Δu (m)")
-    ax2.legend(fontsize=7)
-    ax2.set_xlim(ax1.get_xlim())
-    e = f["energy"]
-    ax3.plot(f["times"] * 1e3, e / e[0] - 1.0, "C0-", lw=1)
-    ax3.set_xlabel("t (ms)")
-    ax3.set_ylabel("E(t)/E(0) − 1")
-    ax2.set_xlabel("x (m)")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)

@@ -5,32 +5,36 @@ Dynamic integrators (see ``docs/dynamics.md``), selected by name or class throug
 
 ==========================  ===============================================================
 ``"explicit"``              :class:`CentralDifference`: lumped weighted masses, constraint
-                            impulses at velocity level, critical step computed
+                            impulses at velocity level, critical step computed, variable steps
 ``"newmark"``               :class:`Newmark` (β, γ) on the monolithic saddle point
 ``"hht"``                   :class:`HHTAlpha`: Newmark with numerical damping
 ``"theta"``                 :class:`ThetaScheme`: θ-scheme on (u, v)
 ==========================  ===============================================================
 
-Constraints: equality rows are :class:`arlequin.system.LinearConstraint`; unilateral rows
-(contact) follow :class:`UnilateralConstraint`.
+Step sizes come from a step controller (:class:`FixedStep`, :class:`CriticalFraction`,
+:class:`StepSchedule`) or from the caller (``integrator.step(dt)``). Constraints: equality rows
+are :class:`arlequin.system.LinearConstraint`; unilateral rows (contact) follow
+:class:`arlequin.contract.UnilateralConstraint` (:class:`LinearInequality` is the minimal one).
+
+One concept a module: ``operators`` (mass, forces, tangents), ``rows`` (constraint rows),
+``linalg`` (factorisations), ``controllers`` (step sizes), ``base`` (the :class:`Integrator`
+class), ``registry``, ``explicit``, ``implicit``, ``stability``, ``recorder``, ``result``,
+``driver`` (:func:`solve`), ``static``, ``loads``.
 """
 
-from .base import (
-    REGISTRY,
-    ConstraintError,
-    DynamicResult,
-    Integrator,
-    SimulationError,
-    SystemOperators,
-    get_integrator,
-    register,
-    solve,
-)
-from .constraints import LinearInequality, UnilateralConstraint, is_unilateral
-from .explicit import DEFAULT_SAFETY, CentralDifference
+from ..contract import ConstraintError, SimulationError, UnilateralConstraint
+from .base import Integrator, IntegratorSnapshot
+from .constraints import LinearInequality, is_unilateral
+from .controllers import CriticalFraction, FixedStep, StepController, StepSchedule
+from .driver import solve
+from .explicit import CentralDifference
 from .implicit import HHTAlpha, ImplicitIntegrator, Newmark, ThetaScheme
 from .loads import Constant, LoadCurve, Ramp, Sine, SmoothStep, Tabulated
-from .stability import StableStep, stable_time_step
+from .operators import SystemOperators
+from .recorder import Recorder
+from .registry import REGISTRY, get_integrator, register
+from .result import DynamicResult
+from .stability import DEFAULT_SAFETY, StableStep, check_time_step, stable_time_step
 from .static import SingularSystemError, StaticResult, solve_static
 
 __all__ = [
@@ -39,24 +43,31 @@ __all__ = [
     "CentralDifference",
     "Constant",
     "ConstraintError",
+    "CriticalFraction",
     "DynamicResult",
+    "FixedStep",
     "HHTAlpha",
     "ImplicitIntegrator",
     "Integrator",
+    "IntegratorSnapshot",
     "LinearInequality",
     "LoadCurve",
     "Newmark",
     "Ramp",
+    "Recorder",
     "SimulationError",
     "Sine",
     "SingularSystemError",
     "SmoothStep",
     "StableStep",
     "StaticResult",
+    "StepController",
+    "StepSchedule",
     "SystemOperators",
     "Tabulated",
     "ThetaScheme",
     "UnilateralConstraint",
+    "check_time_step",
     "get_integrator",
     "is_unilateral",
     "register",

@@ -1,4 +1,4 @@
-"""Constraint protocol of the dynamic integrators.
+"""Unilateral rows ``G u ≤ h(t)``: a minimal, complete implementation of the constraint protocol.
 
 Two families of constraint rows enter every integrator through Lagrange multipliers:
 
@@ -7,153 +7,81 @@ or ``B v = g(t)`` at velocity level. Arlequin mediator equations (``kind="coupli
 conditions (``kind="dirichlet"``) and prescribed velocities are of this kind. Their rows are fixed
 for the whole run, so the integrators factorise what depends on them once.
 
-*Unilateral rows* (:class:`UnilateralConstraint`): a set of candidate rows ``G`` (m×n) of which
-only the currently *active* ones are enforced as equalities (at the constraint's ``level``); the
-multipliers of the inactive rows are zero. The active set is decided inside each time step by the
-constraint object itself: the integrator solves the step's constrained problem with the current
-statuses, passes the predicted end-of-step displacement, velocity and multipliers to
-:meth:`UnilateralConstraint.update_status`, and repeats the constrained solve until no status
-changes or a cap on the iterations is reached (the count is recorded; reaching the cap is logged
-and counted, not fatal). This is the primal–dual active-set / indicator fixed point of the
-level-set (Signorini–Moreau) contact model of ``docs/dynamics.md``.
+*Unilateral rows* (:class:`arlequin.contract.UnilateralConstraint`): candidate rows of which only
+the currently *active* ones are enforced as equalities; the active set is decided inside each
+time step by the constraint (a primal–dual active-set / indicator fixed point, the level-set
+contact model's). The constraint object holds its configuration only: the integrator passes its
+immutable state in and commits the new one (see the protocol).
 
-Sign convention (all constraints)
----------------------------------
-The force a constraint exerts on the system is ``−Bᵀλ`` (N), with ``λ`` the multiplier reported by
-the integrators, as in the static saddle point ``K u + Bᵀλ = f``. For an inequality ``G u ≤ h``
-the admissible multipliers are ``λ ≥ 0``. A contact model that wants the pressure to be negative
-(``λ ≤ 0``, ``docs/DESIGN`` §3) passes the rows ``−G`` instead.
+This module gives :class:`LinearInequality`, rows fixed in time (rigid obstacles, gaps between
+nodes). Sign convention: the force on the system is ``−Gᵀλ`` with ``λ ≥ 0`` admissible; a model
+whose pressure is negative (``λ ≤ 0``, the contact models) passes the rows ``−G`` instead.
 """
 
 from __future__ import annotations
 
-import logging
 from collections.abc import Callable
+from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
 
-__all__ = ["LinearInequality", "UnilateralConstraint", "is_unilateral"]
+from ..contract import UnilateralConstraint, is_unilateral
 
-logger = logging.getLogger(__name__)
+__all__ = [
+    "InequalityState",
+    "InequalityTrial",
+    "LinearInequality",
+    "UnilateralConstraint",
+    "is_unilateral",
+]
 
 
-def is_unilateral(constraint: object) -> bool:
-    """Whether a constraint object follows the unilateral protocol (has ``update_status``)."""
-    return callable(getattr(constraint, "update_status", None))
-
-
-class UnilateralConstraint:
-    """Base class of constraints whose active rows are decided inside each time step.
-
-    Subclasses implement :meth:`matrix`, :meth:`rhs` and :meth:`update_status`; they may override
-    :meth:`begin_step` (update the geometry, guess the statuses) and :meth:`end_step` (commit).
-
-    Parameters
-    ----------
-    name : str
-        Name used in reports and in the multiplier histories.
-    level : {"velocity", "displacement"}
-        Whether an active row enforces ``G v = rhs(t)`` on the end-of-step velocity or
-        ``G u = rhs(t)`` on the end-of-step displacement.
-    max_iterations : int
-        Cap on the status iterations of one step (the integrator uses the largest cap of its
-        unilateral constraints).
-    kind : str
-        Reporting group of the constraint work (default ``"contact"``).
+@dataclass(frozen=True)
+class InequalityState:
+    """Committed state of a :class:`LinearInequality` (immutable).
 
     Attributes
     ----------
     active : ndarray of bool, shape (m,)
-        Current statuses (True: the row is enforced as an equality).
-    iterations : int
-        Status iterations used by the last step.
+        Statuses after the last step (the next step's first guess).
+    work : float
+        Accumulated work of the constraint forces (J), −Σ Λ·G (v⁻ + v⁺)/2 over the steps'
+        impulses Λ = ∫ λ dt.
+    record : None
+        No per-step record.
     """
 
-    def __init__(
-        self,
-        name: str = "unilateral",
-        level: str = "velocity",
-        max_iterations: int = 25,
-        kind: str = "contact",
-    ) -> None:
-        if level not in ("velocity", "displacement"):
-            raise ValueError(
-                f"constraint level must be 'velocity' or 'displacement', got {level!r}"
-            )
-        if max_iterations < 1:
-            raise ValueError(f"max_iterations must be >= 1, got {max_iterations}")
-        self.name = name
-        self.level = level
-        self.max_iterations = int(max_iterations)
-        self.kind = kind
-        self.iterations = 0
-        self._active: np.ndarray | None = None
-
-    # ------------------------------------------------------------------ rows
-    @property
-    def n_rows(self) -> int:
-        """Number of candidate rows m."""
-        return int(self.matrix().shape[0])
-
-    def matrix(self) -> sp.csr_matrix:
-        """Candidate rows G, shape (m, n), in the current configuration."""
-        raise NotImplementedError
-
-    def rhs(self, t: float) -> np.ndarray:
-        """Right-hand side of the active rows at time ``t`` (s), shape (m,) (m or m/s)."""
-        return np.zeros(self.n_rows)
-
-    @property
-    def active(self) -> np.ndarray:
-        if self._active is None:
-            self._active = np.zeros(self.n_rows, dtype=bool)
-        return self._active
-
-    @active.setter
-    def active(self, value: np.ndarray) -> None:
-        self._active = np.asarray(value, dtype=bool).copy()
-
-    # ------------------------------------------------------------------ step protocol
-    def begin_step(self, t: float, dt: float, u: np.ndarray, v: np.ndarray) -> None:
-        """Called once per step before the first constrained solve.
-
-        Parameters
-        ----------
-        t : float
-            Time at the start of the step (s).
-        dt : float
-            Time step (s).
-        u, v : ndarray, shape (n,)
-            Displacement (m) and velocity (m/s) at the start of the step.
-        """
-
-    def update_status(self, u: np.ndarray, v: np.ndarray, multipliers: np.ndarray) -> bool:
-        """Update :attr:`active` from the predicted end-of-step quantities.
-
-        Parameters
-        ----------
-        u, v : ndarray, shape (n,)
-            Predicted end-of-step displacement (m) and velocity (m/s) obtained with the current
-            statuses.
-        multipliers : ndarray, shape (m,)
-            Multipliers (N) of all candidate rows, zero on the inactive ones.
-
-        Returns
-        -------
-        bool
-            True if any status changed (the integrator then repeats the constrained solve).
-        """
-        raise NotImplementedError
-
-    def end_step(self, t: float, u: np.ndarray, v: np.ndarray, multipliers: np.ndarray) -> None:
-        """Called once the step is accepted (t is the end-of-step time, s)."""
+    active: np.ndarray
+    work: float = 0.0
+    record: Any = None
 
 
-class LinearInequality(UnilateralConstraint):
+@dataclass(frozen=True)
+class InequalityTrial:
+    """A :class:`LinearInequality` during one step (immutable); see
+    :class:`arlequin.contract.ConstraintTrial`.
+
+    Attributes
+    ----------
+    bound : ndarray, shape (m,)
+        h at the end of the step (m).
+    closed : ndarray of bool, shape (m,) or None
+        Velocity level: rows whose gap predicted with the step's free velocity is closed (S_d).
+    """
+
+    active: np.ndarray
+    matrix: sp.csr_matrix
+    rhs: np.ndarray
+    bound: np.ndarray
+    closed: np.ndarray | None
+    changed: bool = False
+    iterations: int = 0
+
+
+class LinearInequality:
     """Unilateral rows ``G u ≤ h(t)`` with multipliers ``λ ≥ 0`` (force on the system −Gᵀλ).
-
-    A minimal, complete implementation of the protocol (rigid obstacles, gaps between nodes).
 
     ``level="displacement"`` (Signorini, primal–dual active set)
         An inactive row becomes active when the predicted end-of-step ``G u − h`` exceeds
@@ -172,9 +100,14 @@ class LinearInequality(UnilateralConstraint):
         Rows G on the global dof vector.
     bound : ndarray (m,), float or callable
         h(t) (m); the velocity-level rows enforce G v = dh/dt = 0 (fixed obstacles).
-    level, name, max_iterations : see :class:`UnilateralConstraint`
+    level : {"displacement", "velocity"}
+    name : str
+    max_iterations : int
+        Cap on the status iterations of one step.
     gap_tol : float
         Gap tolerance (m).
+    kind : str
+        Reporting group of the constraint work.
     """
 
     def __init__(
@@ -187,40 +120,73 @@ class LinearInequality(UnilateralConstraint):
         gap_tol: float = 0.0,
         kind: str = "contact",
     ) -> None:
-        super().__init__(name=name, level=level, max_iterations=max_iterations, kind=kind)
+        if level not in ("velocity", "displacement"):
+            raise ValueError(
+                f"constraint level must be 'velocity' or 'displacement', got {level!r}"
+            )
+        if max_iterations < 1:
+            raise ValueError(f"max_iterations must be >= 1, got {max_iterations}")
+        self.name = name
+        self.level = level
+        self.max_iterations = int(max_iterations)
+        self.kind = kind
         self._g = sp.csr_matrix(matrix)
         self._bound = bound
         self.gap_tol = float(gap_tol)
 
+    @property
+    def n_rows(self) -> int:
+        return int(self._g.shape[0])
+
     def matrix(self) -> sp.csr_matrix:
+        """Rows G, shape (m, n)."""
         return self._g
 
     def bound(self, t: float) -> np.ndarray:
         """h(t), shape (m,) (m)."""
         b = self._bound(t) if callable(self._bound) else self._bound
-        return np.broadcast_to(np.asarray(b, dtype=float), (self._g.shape[0],)).copy()
+        return np.broadcast_to(np.asarray(b, dtype=float), (self.n_rows,)).copy()
 
-    def rhs(self, t: float) -> np.ndarray:
-        if self.level == "displacement":
-            return self.bound(t)
-        return np.zeros(self._g.shape[0])
+    # ------------------------------------------------------------------ protocol
+    def initial_state(self, u: np.ndarray, v: np.ndarray) -> InequalityState:
+        return InequalityState(np.zeros(self.n_rows, dtype=bool))
 
-    def update_status(self, u: np.ndarray, v: np.ndarray, multipliers: np.ndarray) -> bool:
-        old = self.active.copy()
-        lam = np.asarray(multipliers, dtype=float)
-        if self.level == "displacement":
-            gap = self._g @ u - self._pending_bound
-            new = np.where(old, lam >= 0.0, gap > self.gap_tol)
-        else:
-            approach = self._g @ v > 0.0
-            new = self._closed & np.where(old, lam >= 0.0, approach)
-        self.active = new
-        return bool(np.any(new != old))
-
-    def begin_step(self, t: float, dt: float, u: np.ndarray, v: np.ndarray) -> None:
-        # the bound at the end of the step, used by update_status
-        self._pending_bound = self.bound(t + dt)
+    def begin_step(
+        self, state: InequalityState, t: float, dt: float, u: np.ndarray, v: np.ndarray
+    ) -> InequalityTrial:
+        bound = self.bound(t + dt)  # at the end of the step
         if self.level == "velocity":
             # S_d: the gap predicted with the step's free velocity, fixed during the iterations
-            self._closed = self._g @ (u + dt * v) - self._pending_bound >= -self.gap_tol
-            self.active = self.active & self._closed
+            closed = self._g @ (u + dt * v) - bound >= -self.gap_tol
+            return InequalityTrial(
+                state.active & closed, self._g, np.zeros(self.n_rows), bound, closed
+            )
+        return InequalityTrial(state.active.copy(), self._g, bound, bound, None)
+
+    def update_status(
+        self, trial: InequalityTrial, u: np.ndarray, v: np.ndarray, multipliers: np.ndarray
+    ) -> InequalityTrial:
+        old = trial.active
+        lam = np.asarray(multipliers, dtype=float)
+        if self.level == "displacement":
+            new = np.where(old, lam >= 0.0, self._g @ u - trial.bound > self.gap_tol)
+        else:
+            new = trial.closed & np.where(old, lam >= 0.0, self._g @ v > 0.0)
+        return replace(
+            trial, active=new, changed=bool(np.any(new != old)), iterations=trial.iterations + 1
+        )
+
+    def commit(
+        self,
+        state: InequalityState,
+        trial: InequalityTrial,
+        *,
+        t: float,
+        u: np.ndarray,
+        v_before: np.ndarray,
+        v_after: np.ndarray,
+        multipliers: np.ndarray,
+        impulse: np.ndarray,
+    ) -> InequalityState:
+        work = -0.5 * float(impulse @ (self._g @ (v_before + v_after)))
+        return InequalityState(trial.active.copy(), state.work + work)

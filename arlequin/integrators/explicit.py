@@ -1,12 +1,14 @@
 """Explicit central differences with lumped weighted masses and velocity-level constraint impulses.
 
-Each step (Δt constant, lumped α-weighted mass M, diagonal):
+Variable steps (Δt_n from t_n to t_{n+1}, Δt̄_n = ½(Δt_{n−1} + Δt_n), Δt_{−1} = 0), lumped
+α-weighted mass M (diagonal):
 
-1. free prediction of the mid-step velocity ``v* = v^{n−1/2} + Δt M⁻¹ (f_ext(t_n) − f_int(u^n))``;
+1. free prediction ``v* = v^{n−1/2} + Δt̄_n M⁻¹ (f_ext(t_n) − f_int(u^n))`` (v^{−1/2} = v^0:
+   the first step is the usual half step);
 2. impulses Λ (N·s) that make the corrected velocity ``v^{n+1/2} = v* − M⁻¹ Bᵀ Λ`` satisfy every
    equality row at velocity level:
 
-   * displacement rows ``B u = g``: ``B v^{n+1/2} = (g(t_{n+1}) − B u^n)/Δt`` (the end-of-step
+   * displacement rows ``B u = g``: ``B v^{n+1/2} = (g(t_{n+1}) − B u^n)/Δt_n`` (the end-of-step
      displacement satisfies the row exactly: no drift);
    * velocity rows ``B v = g``: ``B v^{n+1/2} = g(t_{n+1/2})``;
 
@@ -14,14 +16,18 @@ Each step (Δt constant, lumped α-weighted mass M, diagonal):
    ``C_c M_c⁻¹ C_cᵀ + C_f M_f⁻¹ C_fᵀ``; the masses being constant (total Lagrangian), it is
    factorised once. Active unilateral rows (contact) are added by a Schur complement on that
    factorisation, and the step's solve is repeated until their statuses settle;
-3. ``u^{n+1} = u^n + Δt v^{n+1/2}``.
+3. ``u^{n+1} = u^n + Δt_n v^{n+1/2}``.
 
-Multipliers are reported as forces λ = Λ/Δt at t_n (force on the system −Bᵀλ). The full-step
-velocity is the average of the two mid-step velocities, ``v^n = (v^{n−1/2} + v^{n+1/2})/2``
-(for time-independent rows it equals the RATTLE full-step velocity, projected on the rows), so
-the impulse of step n is computed at the end of step n−1 and everything at t_n (u, v, a, λ,
-energies) is known after each call of :meth:`CentralDifference.step`. Works are accumulated by the
-trapezoidal rule on the powers at t_n and t_{n+1}: external ``f·v``, constraint ``−λ·B v``.
+This is velocity Verlet with the steps Δt_n, second order for any step sequence. Multipliers are
+reported as forces λ^n = Λ^n/Δt̄_n at t_n (force on the system −Bᵀλ). The full-step velocity
+splits the kick at t_n in proportion to the two half steps,
+``v^n = v^{n−1/2} + Δt_{n−1}/(Δt_{n−1} + Δt_n) (v^{n+1/2} − v^{n−1/2})`` (the mean of the two
+mid-step velocities for a constant step; for time-independent rows it is projected on the rows),
+so the impulse at t_n is computed at the end of step n−1 with the step Δt_n chosen then, and
+everything at t_n (u, v, a, λ, energies) is known after each call of
+:meth:`CentralDifference.step`; imposing another Δt_n (``step(dt)``, ``set_step_size``) redoes
+that impulse. Works are accumulated by the trapezoidal rule on the powers at t_n and t_{n+1}:
+external ``f·v``, constraint ``−λ·B v``.
 
 With linear models a step is one sparse mat-vec with the assembled stiffness, a few vector
 operations, two small sparse products with the rows restricted to the dofs they touch, and one
@@ -38,23 +44,25 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from .base import ConstraintError, Integrator, _factor_checked, register, unilateral_block_power
-from .stability import StableStep, stable_time_step
+from ..contract import ConstraintError, SimulationError, capabilities
+from .base import Integrator
+from .controllers import FixedStep, StepController
+from .linalg import factor_checked
+from .registry import register
+from .rows import rows_key, unilateral_block_power
+from .stability import DEFAULT_SAFETY, StableStep, check_time_step, stable_time_step
 
 __all__ = ["DEFAULT_SAFETY", "CentralDifference"]
 
 logger = logging.getLogger(__name__)
-
-#: Default ratio of the time step to the computed critical step of the coupled system.
-DEFAULT_SAFETY = 0.9
 
 
 class _ImpulseSolver:
     """Solves (B M⁻¹ Bᵀ) Λ = r for the equality rows E plus the active unilateral rows A.
 
     The equality block S_EE is factorised once; active rows enter by a Schur complement
-    (dense, cached per active pattern), or by a sparse factorisation of the whole matrix when
-    there are many of them.
+    (dense, cached for the last active rows, keyed by their content), or by a sparse
+    factorisation of the whole matrix when there are many of them.
     """
 
     _DENSE_SCHUR = 300
@@ -67,15 +75,8 @@ class _ImpulseSolver:
             bj = rows.matrix_cols
             s = (bj @ sp.diags(inv_mass[rows.cols]) @ bj.T).tocsc()
             self.s_ee = s
-
-            def row_name(i: int) -> str:
-                for name, sl in rows.slices.items():
-                    if sl.start <= i < sl.stop:
-                        return f"row {i - sl.start} of constraint {name!r}"
-                return f"row {i}"
-
-            self.lu = _factor_checked(
-                s, "the impulse matrix B M⁻¹ Bᵀ of the equality rows", row_name, spd=True
+            self.lu = factor_checked(
+                s, "the impulse matrix B M⁻¹ Bᵀ of the equality rows", rows.row_name, spd=True
             )
         else:
             self.s_ee = None
@@ -85,26 +86,32 @@ class _ImpulseSolver:
     def solve_equality(self, r: np.ndarray) -> np.ndarray:
         return self.lu.solve(r) if self.m_e else np.zeros(0)
 
-    def solve(self, r_e: np.ndarray, g_a: sp.csr_matrix, r_a: np.ndarray, key: Any):
+    def _cached(self, key: bytes, build):
+        fac = self._cache.get(key)
+        if fac is None:
+            fac = build()
+            self._cache = {key: fac}
+        return fac
+
+    def solve(self, r_e: np.ndarray, g_a: sp.csr_matrix, r_a: np.ndarray):
         """Return (Λ_E, Λ_A) for right-hand sides r_e (m_E,), r_a (m_A,) and active rows g_a."""
         m_a = g_a.shape[0]
         if m_a == 0:
             return self.solve_equality(r_e), np.zeros(0)
+        key = rows_key(g_a)
         minv = self.inv_mass
-        s_aa = (g_a @ sp.diags(minv) @ g_a.T).tocsr()
         if self.m_e == 0:
-            fac = self._cache.get(key)
-            if fac is None:
-                fac = (
-                    "lu",
-                    _factor_checked(s_aa, "the impulse matrix of the active rows", spd=True),
-                )
-                self._cache = {key: fac}
-            return np.zeros(0), fac[1].solve(r_a)
+
+            def build_aa():
+                s_aa = (g_a @ sp.diags(minv) @ g_a.T).tocsr()
+                return factor_checked(s_aa, "the impulse matrix of the active rows", spd=True)
+
+            return np.zeros(0), self._cached(key, build_aa).solve(r_a)
         s_ae = (g_a @ sp.diags(minv) @ self.rows.matrix.T).tocsr()
         if m_a <= self._DENSE_SCHUR:
-            fac = self._cache.get(key)
-            if fac is None:
+
+            def build_schur():
+                s_aa = (g_a @ sp.diags(minv) @ g_a.T).tocsr()
                 x = self.lu.solve(s_ae.T.toarray()) if s_ae.nnz else np.zeros((self.m_e, m_a))
                 schur = s_aa.toarray() - s_ae @ x
                 try:
@@ -114,21 +121,19 @@ class _ImpulseSolver:
                         "active unilateral rows are dependent on each other or on the equality "
                         f"rows ({m_a} active rows)"
                     ) from exc
-                fac = ("schur", x, cho)
-                self._cache = {key: fac}
-            _, x, cho = fac
+                return x, cho
+
+            x, cho = self._cached(key, build_schur)
             y = self.lu.solve(r_e)
             lam_a = sla.cho_solve(cho, r_a - s_ae @ y)
             return y - x @ lam_a, lam_a
-        fac = self._cache.get(key)
-        if fac is None:
+
+        def build_full():
+            s_aa = (g_a @ sp.diags(minv) @ g_a.T).tocsr()
             full = sp.bmat([[self.s_ee, s_ae.T], [s_ae, s_aa]], format="csc")
-            fac = (
-                "full",
-                _factor_checked(full, "the impulse matrix with the active rows", spd=True),
-            )
-            self._cache = {key: fac}
-        sol = fac[1].solve(np.concatenate([r_e, r_a]))
+            return factor_checked(full, "the impulse matrix with the active rows", spd=True)
+
+        sol = self._cached(key, build_full).solve(np.concatenate([r_e, r_a]))
         return sol[: self.m_e], sol[self.m_e :]
 
 
@@ -149,12 +154,15 @@ class CentralDifference(Integrator):
     check_dt : bool
         Refuse a step above the critical one (default True).
     **kwargs
-        See :class:`arlequin.integrators.Integrator`.
+        See :class:`arlequin.integrators.base.Integrator` (``step_controller`` among them: e.g.
+        :class:`~arlequin.integrators.CriticalFraction` to follow a changing configuration).
 
     Attributes
     ----------
     stable_step : StableStep
-        The critical-step estimates.
+        The critical-step estimates at the initial configuration.
+    constraint_time : float
+        Wall time (s) spent in the constraint impulses (transfers B v, Bᵀ Λ and the solves).
     """
 
     name = "explicit"
@@ -179,11 +187,14 @@ class CentralDifference(Integrator):
         self.check_dt = bool(check_dt)
         self.stable_step: StableStep | None = None
         self._solver: _ImpulseSolver | None = None
-        #: wall time (s) spent in the constraint impulses (transfers B v, Bᵀ Λ and the solve)
+        self._model_steps0: dict[tuple[int, int], float] = {}
+        self._critical_now: float | None = None
+        self._critical_at: int | None = None
+        self._impulse_failed = False
         self.constraint_time = 0.0
         super().__init__(system, dt, **kwargs)
 
-    # ------------------------------------------------------------------ set-up
+    # ------------------------------------------------------------------ stable step
     def _impulse_solver(self) -> _ImpulseSolver:
         if self._solver is None:
             self._solver = _ImpulseSolver(self.rows, self.ops.inv_mass)
@@ -192,26 +203,76 @@ class CentralDifference(Integrator):
             self._no_lam = np.zeros(0)
         return self._solver
 
-    def _choose_dt(self, dt: float | None) -> float:
-        solver = self._impulse_solver()
-        if self.stable_step is None and (dt is None or self.check_dt):
+    def _stable(self) -> StableStep:
+        if self.stable_step is None:
+            solver = self._impulse_solver()
             self.stable_step = stable_time_step(
                 self.system, self.stable_method, _ops=self.ops, _rows=self.rows, _s_lu=solver.lu
             )
             self.critical_dt = self.stable_step.critical
-        if dt is None:
-            return self.safety * self.stable_step.critical
-        dt = float(dt)
-        if self.check_dt and dt > self.stable_step.critical * (1.0 + 1e-12):
-            s = self.stable_step
-            raise ValueError(
-                f"time step dt={dt:.6e} s exceeds the critical step of the coupled explicit "
-                f"system, {s.critical:.6e} s ({s.method} estimate; per-model bound "
-                f"{s.block_bound:.6e} s): use dt <= {s.critical:.6e} s"
-            )
+        return self.stable_step
+
+    def critical_time_step(self, max_age: int = 0) -> float:
+        """Critical step (s) of the coupled system in the current configuration.
+
+        The computed critical step of the initial configuration (:attr:`stable_step`), scaled by
+        ``min_m Δt_m(u)/Δt_m(0)`` over the nonlinear models that declare the
+        ``"critical_time_step"`` capability (their own element estimates in the current and the
+        initial configuration); linear systems keep the initial value.
+
+        Parameters
+        ----------
+        max_age : int
+            Return the last estimate if it was made at most this many steps ago (0: estimate
+            now).
+        """
+        crit = self._stable().critical
+        u = getattr(self, "u", None)
+        if u is None:
+            self._critical_now = crit
+            return crit
+        if (
+            self._critical_now is not None
+            and self._critical_at is not None
+            and self.step_count - self._critical_at < max(max_age, 1)
+            and max_age > 0
+        ):
+            return self._critical_now
+        self._critical_at = self.step_count
+        ratio = 1.0
+        for bi, b in enumerate(self.ops.blocks):
+            if self.ops.block_linear[bi]:
+                continue
+            for ti, term in enumerate(b.terms):
+                if "critical_time_step" not in capabilities(term.model):
+                    continue
+                key = (bi, ti)
+                ut = self.ops._term_u(b, term, u)
+                if key not in self._model_steps0:
+                    self._model_steps0[key] = float(
+                        term.model.critical_time_step(np.zeros_like(ut), None)
+                    )
+                now = float(term.model.critical_time_step(ut, self.states[b.name][ti]))
+                ratio = min(ratio, now / self._model_steps0[key])
+        self._critical_now = crit * ratio
+        return self._critical_now
+
+    def _default_controller(self) -> StepController:
+        return FixedStep(self.safety * self._stable().critical)
+
+    def _check_step_size(self, dt: float) -> float:
+        if self.check_dt:
+            stable = self._stable()
+            # the latest estimate (a CriticalFraction controller refreshes it)
+            now = self._critical_now if self._critical_now is not None else stable.critical
+            if now != stable.critical:
+                stable = StableStep(
+                    now, stable.block_bound, stable.per_block, 2.0 / now, "current-configuration"
+                )
+            check_time_step(dt, stable)
         return dt
 
-    # ------------------------------------------------------------------ helpers
+    # ------------------------------------------------------------------ impulses
     def _rhs_equality(self, v_star: np.ndarray, u: np.ndarray, t_next: float) -> np.ndarray:
         """B v* − w for the equality rows, w the velocity targets of the mid-step velocity
         ending at t_next: (g(t_next) − B u)/Δt (displacement rows), g(t_next − Δt/2) (velocity
@@ -229,87 +290,84 @@ class CentralDifference(Integrator):
         g_mid = rows.g(t_next - 0.5 * dt) if rows.time_dependent else g_end
         return bv - np.where(disp, (g_end - bu) / dt, g_mid)
 
-    def _impulse(
-        self, v_star: np.ndarray, u: np.ndarray, t: float, scale: float
-    ) -> tuple[np.ndarray, np.ndarray, list[np.ndarray], sp.csr_matrix, np.ndarray]:
-        """Impulses making ``v_star − scale·M⁻¹BᵀΛ`` satisfy the rows for the step from t.
+    def _impulse(self, v_star: np.ndarray, dt_bar: float):
+        """Impulses making ``v_star − M⁻¹BᵀΛ`` satisfy the rows for the step from t.
 
-        ``scale`` is 1 for a full step and 1/2 for the initial half step. ``v_star`` is
-        overwritten. Returns (Λ_E, Λ_A, [full unilateral multipliers per constraint, as
-        forces], G_A, v_new).
+        ``v_star`` is overwritten. Returns (Λ_E, Λ_A, full unilateral multipliers per constraint
+        as forces, G_A, v_new, trials).
         """
         rows = self.rows
         dt = self.dt
+        u, t = self.u, self.t
         solver = self._impulse_solver()
-        t_next = t + dt
-        r_e = self._rhs_equality(v_star, u, t_next) / scale if rows.m else np.zeros(0)
+        t_next = self._end_time()
+        r_e = self._rhs_equality(v_star, u, t_next) if rows.m else np.zeros(0)
         minv = self.ops.inv_mass
         if not self.unilateral:
             lam_e = solver.solve_equality(r_e)
             v_new = v_star
             if rows.m:
-                v_new[rows.cols] -= (scale * self._minv_cols) * (rows.matrix_cols_t @ lam_e)
+                v_new[rows.cols] -= self._minv_cols * (rows.matrix_cols_t @ lam_e)
             self.status_iterations = 0
-            return lam_e, self._no_lam, [], self._no_rows, v_new
-        for c in self.unilateral:
-            c.begin_step(t, dt, u, v_star)
+            return lam_e, self._no_lam, [], self._no_rows, v_new, []
+        trials = self._begin_unilateral(t, dt, u, v_star)
         converged = False
         it = 0
         while it < self.max_status_iterations:
             it += 1
-            g_a, idx = self._active_rows()
-            v_trial = v_star.copy()
-            rhs_a = (
-                np.concatenate([c.rhs(t_next)[a] for c, a in zip(self.unilateral, idx)])
-                if idx
-                else np.zeros(0)
-            )
-            lev_disp = (
-                np.concatenate(
-                    [
-                        np.full(a.size, c.level == "displacement")
-                        for c, a in zip(self.unilateral, idx)
-                    ]
-                )
-                if idx
-                else np.zeros(0, dtype=bool)
-            )
-            w_a = np.where(lev_disp, (rhs_a - g_a @ u) / dt, rhs_a)
-            r_a = (g_a @ v_trial - w_a) / scale
-            key = tuple(a.tobytes() for a in idx) + tuple(id(c.matrix()) for c in self.unilateral)
-            lam_e, lam_a = solver.solve(r_e, g_a, r_a, key)
-            v_new = v_trial
+            g_a, rhs_a, idx, disp = self._active(trials)
+            w_a = np.where(disp, (rhs_a - g_a @ u) / dt, rhs_a)
+            r_a = g_a @ v_star - w_a
+            lam_e, lam_a = solver.solve(r_e, g_a, r_a)
+            v_new = v_star.copy()
             if rows.m:
-                v_new[rows.cols] -= scale * minv[rows.cols] * (rows.matrix_cols_t @ lam_e)
+                v_new[rows.cols] -= minv[rows.cols] * (rows.matrix_cols_t @ lam_e)
             if g_a.shape[0]:
-                v_new -= scale * minv * (g_a.T @ lam_a)
-            fulls = self._unilateral_full(lam_a / dt, idx)
-            u_pred = u + dt * v_new
-            if not self._update_statuses(u_pred, v_new, fulls):
+                v_new -= minv * (g_a.T @ lam_a)
+            fulls = self._full_multipliers(lam_a / dt_bar, idx)
+            trials, changed = self._update_statuses(trials, u + dt * v_new, v_new, fulls)
+            if not changed:
                 converged = True
                 break
         self.status_iterations = it
+        self._impulse_failed = not converged
         if not converged:
-            # the step keeps the last solve; the statuses were updated after it and are the
-            # next step's starting guess
-            self._status_cap_reached()
-        return lam_e, lam_a, fulls, g_a, v_new
+            # the step keeps the last solve; each constraint commits what it used in it
+            self._status_cap_reached(t_next)
+        return lam_e, lam_a, fulls, g_a, v_new, trials
 
-    def _forces(self, u: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray, dict]:
-        f_int, trial, _ = self.ops.internal_force(u, self.states)
-        f_ext = self.system.external_force(t) if self.system.load is not None else None
-        if f_ext is not None and not f_ext.any():
-            f_ext = None  # unloaded at t: skip the force and its power
-        return f_int, f_ext, trial
-
-    def _record_impulse(self, lam_e, fulls, g_a, lam_a) -> None:
+    def _impulse_at_t(self) -> None:
+        """Impulse at the current time t for the step self.dt: sets v^{n+1/2}, v^n, λ^n, the
+        constraint states after it and the powers at t."""
+        dt_prev, dt = self._dt_prev, self.dt
+        dt_bar = 0.5 * (dt_prev + dt)
+        v_minus = self._v_minus
+        v_star = v_minus + dt_bar * self.a
+        tic = time.perf_counter()
+        lam_e, lam_a, fulls, g_a, v_next, trials = self._impulse(v_star, dt_bar)
+        self.constraint_time += time.perf_counter() - tic
+        if trials:
+            self.constraint_states = self._commit_unilateral(
+                trials, self.t, self.u, v_minus, v_next, fulls, [dt_bar * f for f in fulls],
+                states=self._pre_impulse_states,
+            )  # fmt: skip
+        self._v_next = v_next
+        share = dt_prev / (dt_prev + dt)
+        self.v = v_minus + share * (v_next - v_minus) if share else v_minus.copy()
         self._lam_e = lam_e
         self._lam_a = lam_a
         self._g_a = g_a
-        mult = self.rows.split(lam_e / self.dt) if self.rows.m else {}
+        self._dt_bar = dt_bar
+        mult = self.rows.split(lam_e / dt_bar) if self.rows.m else {}
         for c, lam in zip(self.unilateral, fulls):
             mult[c.name] = lam
         self.multipliers = mult
+        self._p_now = self._powers()
+        # works of the step that ended at t (trapezoidal on the powers at both ends): pending
+        # until the next step starts, since a new step size at t changes the powers at t
+        half = 0.5 * dt_prev
+        (pe, pc, po), (qe, qc, qo) = self._p_prev, self._p_now
+        self._w_pending = (half * (pe + qe), half * (pc + qc), half * (po + qo))
 
     def _powers(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """External, coupling and other-constraint powers per block at the current time (W)."""
@@ -317,66 +375,91 @@ class CentralDifference(Integrator):
         v = self.v
         p_ext = self.ops.block_dots(self._f_ext, v) if self._f_ext is not None else np.zeros(nb)
         if self.rows.m:
-            lam = self._lam_e / self.dt
+            lam = self._lam_e / self._dt_bar
             pc, po = self.rows.block_powers(lam, v[self.rows.cols])
         else:
             pc, po = np.zeros(nb), np.zeros(nb)
         if self._g_a.shape[0]:
-            po = po + unilateral_block_power(self.ops, self._g_a, self._lam_a / self.dt, v)
+            po = po + unilateral_block_power(self.ops, self._g_a, self._lam_a / self._dt_bar, v)
         return p_ext, pc, po
+
+    def _forces(self, u: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray | None, dict]:
+        f_int, trial, _ = self.ops.internal_force(u, self.states)
+        f_ext = self.system.external_force(t) if self.system.load is not None else None
+        if f_ext is not None and not f_ext.any():
+            f_ext = None  # unloaded at t: skip the force and its power
+        return f_int, f_ext, trial
+
+    def _acceleration(self, f_int: np.ndarray, f_ext: np.ndarray | None) -> np.ndarray:
+        minv = self.ops.inv_mass
+        return -minv * f_int if f_ext is None else minv * (f_ext - f_int)
 
     # ------------------------------------------------------------------ initial state
     def _initialize(self) -> None:
-        dt = self.dt
-        u, v = self.u, self.v
-        f_int, f_ext, trial = self._forces(u, self.t)
+        f_int, f_ext, trial = self._forces(self.u, self.t)
         self.states = trial
         self._f_int = f_int
         self._f_ext = f_ext
-        minv = self.ops.inv_mass
-        a = -minv * f_int if f_ext is None else minv * (f_ext - f_int)
-        self.a = a
-        # half step: v^{1/2} = v^0 + Δt/2 a^0 − ½ M⁻¹ Bᵀ Λ^0 with B v^{1/2} = w^0
-        lam_e, lam_a, fulls, g_a, v_half = self._impulse(v + 0.5 * dt * a, u, self.t, 0.5)
-        self._v_next = v_half  # v^{1/2}
-        self._record_impulse(lam_e, fulls, g_a, lam_a)
-        self._p_prev = self._powers()
+        self.a = self._acceleration(f_int, f_ext)
+        self._dt_prev = 0.0
+        self._v_minus = self.v.copy()  # v^{-1/2} = v^0: the first kick is a half step
+        self._pre_impulse_states = self.constraint_states
+        nb = len(self.ops.blocks)
+        self._p_prev = (np.zeros(nb), np.zeros(nb), np.zeros(nb))
+        self._impulse_at_t()
+
+    def _step_size_changed(self) -> None:
+        # the impulse at t and everything reported at t depend on the step that follows it
+        if self._impulse_failed:
+            self.n_status_failures -= 1  # that impulse is replaced
+        self.constraint_states = self._pre_impulse_states
+        self._impulse_at_t()
+
+    def _works(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        pe, pc, po = self._w_pending
+        return self._w_ext + pe, self._w_coupling + pc, self._w_constraint + po
+
+    def _scheme_fields(self) -> tuple[str, ...]:
+        return (
+            "_v_next", "_v_minus", "_dt_prev", "_dt_bar", "_f_int", "_f_ext", "_lam_e", "_lam_a",
+            "_g_a", "_p_now", "_p_prev", "_w_pending", "_pre_impulse_states", "_critical_now",
+            "_critical_at", "_impulse_failed",
+        )  # fmt: skip
 
     # ------------------------------------------------------------------ step
     def _step_impl(self) -> None:
         dt = self.dt
-        u_old = self.u
+        t_new = self._end_time()
         v_half = self._v_next
-        u = u_old + dt * v_half
-        self.t = self.t0 + (self.step_count + 1) * dt
-        f_int, f_ext, trial = self._forces(u, self.t)
-        minv = self.ops.inv_mass
-        a = -minv * f_int if f_ext is None else minv * (f_ext - f_int)
-        # impulse at t_{n+1} for the next mid-step velocity
-        v_star = v_half + dt * a
-        tic = time.perf_counter()
-        lam_e, lam_a, fulls, g_a, v_next = self._impulse(v_star, u, self.t, 1.0)
-        self.constraint_time += time.perf_counter() - tic
-        self.states = trial
-        self.u = u
-        self.a = a
-        self.v = 0.5 * (v_half + v_next)
-        self._v_next = v_next
-        self._f_ext = f_ext
-        self._record_impulse(lam_e, fulls, g_a, lam_a)
-        for c, lam in zip(self.unilateral, fulls):
-            c.end_step(self.t, u, self.v, lam)
-        p_new = self._powers()
-        p_old = self._p_prev
-        half = 0.5 * dt
-        self._w_ext += half * (p_old[0] + p_new[0])
-        self._w_coupling += half * (p_old[1] + p_new[1])
-        self._w_constraint += half * (p_old[2] + p_new[2])
+        u_new = self.u + dt * v_half
+        f_int, f_ext, trial = self._forces(u_new, t_new)
+        a_new = self._acceleration(f_int, f_ext)
+        # the step size at t is final now: commit the works of the step that ended at t
+        self._w_ext, self._w_coupling, self._w_constraint = self._works()
+        self._p_prev = self._p_now
+        # commit the step's kinematics and model states
         if not self.ops.linear:
-            du = u - u_old
-            self._w_internal += self.ops.block_dots(du, 0.5 * (self._f_int + f_int))
+            self._w_internal += self.ops.block_dots(u_new - self.u, 0.5 * (self._f_int + f_int))
+        self.u = u_new
+        self.a = a_new
+        self.states = trial
+        self.t = t_new
         self._f_int = f_int
-        self._p_prev = p_new
+        self._f_ext = f_ext
+        self._dt_prev = dt
+        self._v_minus = v_half
+        self.step_size = dt
+        self.step_count += 1
+        # the next step and the impulse at t_{n+1} that depends on it
+        try:
+            self.dt = self._next_step_size()
+            self._pre_impulse_states = self.constraint_states
+            self._impulse_at_t()
+            # a non-finite u or a (NaN, overflow) shows in u or v here
+            self._check_finite(t_new, self.u, self.v, step=self.step_count)
+        except SimulationError:
+            self.status = "failed"
+            raise
 
     # ------------------------------------------------------------------ info
     @property

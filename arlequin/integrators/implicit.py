@@ -41,8 +41,13 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from .base import Integrator, SimulationError, _factor_checked, register, unilateral_block_power
-from .stability import stable_time_step
+from ..contract import SimulationError
+from .base import Integrator
+from .controllers import FixedStep, StepController
+from .linalg import factor_checked
+from .registry import register
+from .rows import rows_key, unilateral_block_power
+from .stability import DEFAULT_SAFETY, stable_time_step
 
 __all__ = ["HHTAlpha", "ImplicitIntegrator", "Newmark", "ThetaScheme"]
 
@@ -65,6 +70,11 @@ class ImplicitIntegrator(Integrator):
         of R (nonlinear models only).
     max_newton : int
         Newton iteration cap (a step that does not converge raises :class:`SimulationError`).
+    newton : {"consistent", "initial"}
+        Tangent of the Newton iterations on nonlinear models: their consistent tangent (the
+        ``"tangent"`` capability, required: a model without it is refused with a
+        :class:`~arlequin.contract.CapabilityError`), or their initial stiffness (modified
+        Newton: linear convergence, for models without a tangent).
     **kwargs
         See :class:`arlequin.integrators.Integrator`.
     """
@@ -84,6 +94,7 @@ class ImplicitIntegrator(Integrator):
         newton_rtol: float = 1e-10,
         newton_atol: float = 0.0,
         max_newton: int = 25,
+        newton: str = "consistent",
         **kwargs: Any,
     ) -> None:
         self.newton_rtol = float(newton_rtol)
@@ -91,7 +102,9 @@ class ImplicitIntegrator(Integrator):
         self.max_newton = int(max_newton)
         self._lu_cache: dict[Any, Any] = {}
         self.newton_iterations = 0
-        super().__init__(system, dt, **kwargs)
+        if newton not in ("consistent", "initial"):
+            raise ValueError(f"newton must be 'consistent' or 'initial', got {newton!r}")
+        super().__init__(system, dt, tangent=newton, **kwargs)
 
     # ------------------------------------------------------------------ scheme hooks
     def _affine(self) -> tuple[np.ndarray, float, np.ndarray, float, np.ndarray, float]:
@@ -107,17 +120,16 @@ class ImplicitIntegrator(Integrator):
         raise NotImplementedError
 
     # ------------------------------------------------------------------ dt, initial state
-    def _choose_dt(self, dt: float | None) -> float:
-        if dt is not None:
-            return float(dt)
-        from .explicit import DEFAULT_SAFETY
-
+    def _default_controller(self) -> StepController:
+        # the explicit scheme's step: lumped operators of their own (this scheme's mass may be
+        # consistent)
         step = stable_time_step(self.system, "coupled")
         self.critical_dt = step.critical
         logger.info("implicit scheme: default dt = %.3g x critical explicit step", DEFAULT_SAFETY)
-        return DEFAULT_SAFETY * step.critical
+        return FixedStep(DEFAULT_SAFETY * step.critical)
 
     def _initialize(self) -> None:
+        self.ops.check_tangents(f"the {self.name} scheme")
         self._lu_cache = {}
         self._empty_rows = sp.csr_matrix((0, self.ops.n))
         f_int, trial, _kt = self.ops.internal_force(self.u, self.states)
@@ -129,6 +141,9 @@ class ImplicitIntegrator(Integrator):
         for c in self.unilateral:
             self.multipliers[c.name] = np.zeros(c.n_rows)
         self._initial_acceleration()
+
+    def _scheme_fields(self) -> tuple[str, ...]:
+        return ("_f_int", "_f_ext", "_fc_old", "_lam", "_lam_e_old", "_uni_old")
 
     def _external(self, t: float) -> np.ndarray:
         if self.system.load is None:
@@ -145,14 +160,14 @@ class ImplicitIntegrator(Integrator):
             h = self.dt
             target = np.where(rows.displacement, rows.rate(self.t, h, 2), rows.rate(self.t, h, 1))
             mat = sp.bmat([[mmat, rows.matrix.T], [rows.matrix, None]], format="csc")
-            lu = _factor_checked(mat, "the initial-acceleration saddle point [[M, Bᵀ], [B, 0]]")
+            lu = factor_checked(mat, "the initial-acceleration saddle point [[M, Bᵀ], [B, 0]]")
             sol = lu.solve(np.concatenate([r, target]))
             a, lam = sol[: self.ops.n], sol[self.ops.n :]
         else:
             a = (
                 r / m
                 if self.ops.lumped
-                else _factor_checked(sp.csc_matrix(m), "the mass", spd=True).solve(r)
+                else factor_checked(sp.csc_matrix(m), "the mass", spd=True).solve(r)
             )
             lam = np.zeros(0)
         self.a = a
@@ -174,18 +189,24 @@ class ImplicitIntegrator(Integrator):
         return sp.bmat([[a, b.T], [b, None]], format="csc")
 
     def _rows_on_x(
-        self, u_p: np.ndarray, c_u: float, v_p: np.ndarray, c_v: float, t_new: float
+        self,
+        u_p: np.ndarray,
+        c_u: float,
+        v_p: np.ndarray,
+        c_v: float,
+        t_new: float,
+        trials: list[Any],
     ) -> tuple[sp.csr_matrix, np.ndarray, list[np.ndarray], Any]:
         """Equality + active unilateral rows written on x: (B, r, active index lists, key)."""
         rows = self.rows
         if not self.unilateral:
             if not rows.m:
-                return self._empty_rows, np.zeros(0), [], ()
+                return self._empty_rows, np.zeros(0), [], (self.dt,)
             g = rows.g(t_new)
             rhs_e = np.where(
                 rows.displacement, (g - rows.matrix @ u_p) / c_u, (g - rows.matrix @ v_p) / c_v
             )
-            return rows.matrix, rhs_e, [], ()
+            return rows.matrix, rhs_e, [], (self.dt,)
         mats, rhs = [], []
         if rows.m:
             g = rows.g(t_new)
@@ -193,27 +214,19 @@ class ImplicitIntegrator(Integrator):
             bv = rows.matrix @ v_p
             rhs.append(np.where(rows.displacement, (g - bu) / c_u, (g - bv) / c_v))
             mats.append(rows.matrix)
-        idx = []
-        for c in self.unilateral:
-            act = np.nonzero(c.active)[0]
-            idx.append(act)
-            gm = c.matrix()[act]
-            h = c.rhs(t_new)[act]
-            if c.level == "displacement":
-                rhs.append((h - gm @ u_p) / c_u)
-            else:
-                rhs.append((h - gm @ v_p) / c_v)
-            mats.append(gm)
+        g_a, rhs_a, idx, disp = self._active(trials)
+        if g_a.shape[0]:
+            rhs.append(np.where(disp, (rhs_a - g_a @ u_p) / c_u, (rhs_a - g_a @ v_p) / c_v))
+            mats.append(g_a)
         n = self.ops.n
         b = sp.vstack(mats, format="csr") if mats else sp.csr_matrix((0, n))
         r = np.concatenate(rhs) if rhs else np.zeros(0)
-        key = tuple(a.tobytes() for a in idx) + tuple(id(c.matrix()) for c in self.unilateral)
-        return b, r, idx, key
+        return b, r, idx, (self.dt, rows_key(g_a))
 
-    def _solve_constrained(self, t_new: float):
-        """One constrained solve (linear or Newton) with the current statuses."""
+    def _solve_constrained(self, t_new: float, trials: list[Any]):
+        """One constrained solve (linear or Newton) with the trials' statuses."""
         u_p, c_u, v_p, c_v, a_p, c_a = self._affine()
-        b, r_rows, idx, key = self._rows_on_x(u_p, c_u, v_p, c_v, t_new)
+        b, r_rows, idx, key = self._rows_on_x(u_p, c_u, v_p, c_v, t_new, trials)
         n = self.ops.n
         f_bar = self.w1 * self._f_ext_new + self.w0 * self._f_ext
         known = f_bar - self._mass_times(a_p) - self.w0 * self._f_int - self.w0c * self._fc_old
@@ -221,7 +234,7 @@ class ImplicitIntegrator(Integrator):
             lu = self._lu_cache.get(key)
             if lu is None:
                 mat = self._system_matrix(self.ops.stiffness, c_a, c_u, b)
-                lu = _factor_checked(
+                lu = factor_checked(
                     mat, f"the {self.name} saddle point [[c_a M + c_u K, Bᵀ], [B, 0]]"
                 )
                 if len(self._lu_cache) >= 8:
@@ -243,7 +256,7 @@ class ImplicitIntegrator(Integrator):
         for it in range(1, self.max_newton + 1):
             res0 = self._mass_times(c_a * x) + self.w1 * f_int - known
             mat = self._system_matrix(kt, c_a, c_u, b)
-            lu = _factor_checked(mat, f"the {self.name} Newton saddle point")
+            lu = factor_checked(mat, f"the {self.name} Newton saddle point")
             sol = lu.solve(np.concatenate([-res0, r_rows - b @ x]))
             dx, mu = sol[:n], sol[n:]
             x = x + dx
@@ -266,27 +279,40 @@ class ImplicitIntegrator(Integrator):
     # ------------------------------------------------------------------ step
     def _step_impl(self) -> None:
         dt = self.dt
-        t_new = self.t0 + (self.step_count + 1) * dt
+        t_new = self._end_time()
         self._f_ext_new = self._external(t_new)
-        for c in self.unilateral:
-            c.begin_step(self.t, dt, self.u, self.v)
+        trials = self._begin_unilateral(self.t, dt, self.u, self.v)
         converged = False
         it = 0
         while it < self.max_status_iterations:
             it += 1
-            x, mu, b, idx, f_int, trial = self._solve_constrained(t_new)
+            x, mu, b, idx, f_int, trial = self._solve_constrained(t_new, trials)
             u_p, c_u, v_p, c_v, _, _ = self._affine()
             u_new = u_p + c_u * x
             v_new = v_p + c_v * x
             m_e = self.rows.m
             lam_all = self._multipliers_from(mu)
-            fulls = self._unilateral_full(lam_all[m_e:], idx)
-            if not self.unilateral or not self._update_statuses(u_new, v_new, fulls):
+            fulls = self._full_multipliers(lam_all[m_e:], idx)
+            if not self.unilateral:
                 converged = True
                 break
-        self.status_iterations = it if self.unilateral else 0
+            trials, changed = self._update_statuses(trials, u_new, v_new, fulls)
+            if not changed:
+                converged = True
+                break
+        self._check_finite(t_new, u_new, v_new)
+        status_iterations = it if self.unilateral else 0
         if not converged:
-            self._status_cap_reached()
+            self._status_cap_reached(t_new)
+        if self.endpoint_multipliers:  # the step's force: the mean of the end-point values
+            impulses = [0.5 * dt * (o + n) for o, n in zip(self._uni_old, fulls)]
+        else:
+            impulses = [dt * f for f in fulls]
+        constraint_states = (
+            self._commit_unilateral(trials, t_new, u_new, self.v, v_new, fulls, impulses)
+            if trials
+            else self.constraint_states
+        )
         # works with the forces of the step: −Δu·Bᵀλ̄ per block (λ̄: mean of the end-point
         # multipliers, or the step multipliers of the θ-scheme)
         du = u_new - self.u
@@ -306,8 +332,8 @@ class ImplicitIntegrator(Integrator):
             w_c, w_o = rows.block_powers(lam_e_w, du[rows.cols])
         else:
             w_c, w_o = np.zeros(nb), np.zeros(nb)
-        for c, lam in zip(self.unilateral, uni_w):
-            w_o = w_o + unilateral_block_power(self.ops, c.matrix(), lam, du)
+        for tr, lam in zip(trials, uni_w):
+            w_o = w_o + unilateral_block_power(self.ops, tr.matrix, lam, du)
         if self.system.load is not None:
             self._w_ext += self.ops.block_dots(du, f_ext_w)
         self._w_coupling += w_c
@@ -315,6 +341,8 @@ class ImplicitIntegrator(Integrator):
         if not self.ops.linear:
             self._w_internal += self.ops.block_dots(du, 0.5 * (self._f_int + f_int))
         # commit
+        self.status_iterations = status_iterations
+        self.constraint_states = constraint_states
         self.u = u_new
         self.v = v_new
         self._finish(x)
@@ -329,8 +357,10 @@ class ImplicitIntegrator(Integrator):
         mult = rows.split(lam_e_new) if m_e else {}
         for c, lam in zip(self.unilateral, fulls):
             mult[c.name] = lam
-            c.end_step(self.t, self.u, self.v, lam)
         self.multipliers = mult
+        self.step_size = dt
+        self.step_count += 1
+        self.dt = self._next_step_size()
 
     def _multipliers_from(self, mu: np.ndarray) -> np.ndarray:
         """Reported multipliers (N) from the unknown μ."""
@@ -453,10 +483,11 @@ class ThetaScheme(ImplicitIntegrator):
 
     def _finish(self, x: np.ndarray) -> None:
         # mean acceleration of the step (m/s²); u and v are already the end-of-step values
-        self.a = (x - self._v_start) / self.dt
+        self.a = (x - self._v_start) / self._dt_step
 
     def _step_impl(self) -> None:
         self._v_start = self.v.copy()
+        self._dt_step = self.dt
         super()._step_impl()
 
     def _initial_acceleration(self) -> None:

@@ -35,10 +35,22 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from ..contract import is_unilateral
 from ..system import CoupledSystem
-from .base import EqualityRows, SystemOperators, _factor_checked
+from .linalg import factor_checked
+from .operators import SystemOperators
+from .rows import EqualityRows
 
-__all__ = ["StableStep", "largest_eigenvalue", "stable_time_step"]
+__all__ = [
+    "DEFAULT_SAFETY",
+    "StableStep",
+    "check_time_step",
+    "largest_eigenvalue",
+    "stable_time_step",
+]
+
+#: Default ratio of the time step to the computed critical step of the coupled system.
+DEFAULT_SAFETY = 0.9
 
 logger = logging.getLogger(__name__)
 
@@ -146,8 +158,9 @@ def stable_time_step(
         raise ValueError(f"method must be 'coupled', 'blocks' or 'gershgorin', got {method!r}")
     ops = _ops if _ops is not None else SystemOperators(system, lumped=True)
     m = np.asarray(ops.mass, dtype=float)
-    _, _, kt = ops.internal_force(np.zeros(ops.n), ops.initial_states(), tangent=True)
-    a = _scaled(kt, m)
+    # the initial (small-strain) stiffness: the tangent of linear models, the initial tangent of
+    # nonlinear ones (the current configuration is followed by CentralDifference.critical_time_step)
+    a = _scaled(ops.initial_stiffness(), m)
     per_block: dict[str, float] = {}
     lam_blocks = []
     for b in ops.blocks:
@@ -159,8 +172,6 @@ def stable_time_step(
     lam = max(lam_blocks) if lam_blocks else 0.0
     if method == "coupled":
         if _rows is None:
-            from .constraints import is_unilateral
-
             eq = [c for c in list(system.constraints) + list(constraints) if not is_unilateral(c)]
             _rows = EqualityRows(eq, ops)
         if _rows.m:
@@ -172,7 +183,7 @@ def stable_time_step(
                 s_lu = _s_lu
                 if s_lu is None:
                     s = (_rows.matrix @ sp.diags(1.0 / m) @ _rows.matrix.T).tocsc()
-                    s_lu = _factor_checked(s, "B M⁻¹ Bᵀ", spd=True)
+                    s_lu = factor_checked(s, "B M⁻¹ Bᵀ", spd=True)
                 btt = bt.T.tocsr()
 
                 def project(y: np.ndarray) -> np.ndarray:
@@ -194,3 +205,21 @@ def stable_time_step(
         omega_max=math.sqrt(max(lam, 0.0)),
         method=method,
     )
+
+
+def check_time_step(dt: float, stable: StableStep) -> None:
+    """Refuse a step above the critical one with a ``ValueError`` giving both numbers.
+
+    Parameters
+    ----------
+    dt : float
+        The step (s).
+    stable : StableStep
+        The critical-step estimate (s) it is checked against.
+    """
+    if dt > stable.critical * (1.0 + 1e-12):
+        raise ValueError(
+            f"time step dt={dt:.6e} s exceeds the critical step of the coupled explicit "
+            f"system, {stable.critical:.6e} s ({stable.method} estimate; per-model bound "
+            f"{stable.block_bound:.6e} s): use dt <= {stable.critical:.6e} s"
+        )

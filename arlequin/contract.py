@@ -1,0 +1,413 @@
+"""The contract between the coupling core and the physics models: protocols and shared errors.
+
+This is the only part of :mod:`arlequin` that the models (:mod:`arlequin.models`) import, besides
+the pure helpers listed in ``docs/architecture.md`` (reference elements, facet geometry, the dof
+layout). Everything the core calls on a model or a constraint is written down here, so that a
+new model or constraint is written against this page and nothing else.
+
+Models
+------
+A model is single-mesh physics that knows nothing about Arlequin. The integrators need
+:class:`DynamicModel`; an :class:`~arlequin.problem.ArlequinProblem` needs the full
+:class:`Model` (mesh, bases and loads as well). Every assembled quantity takes an optional
+quadrature-point ``weight`` (the partition weight α of the coupling, default 1), evaluated at the
+quadrature points of the model's basis: an array of shape ``(n_elems, n_qp)``, a scalar, or a
+callable of the quadrature points ``x`` of shape ``(dim, n_elems, n_qp)``.
+
+Optional capabilities are declared by implementing their protocol (checked with
+:func:`capabilities`), never guessed from other members:
+
+``"tangent"`` (:class:`SupportsTangent`)
+    the consistent tangent ``∂f_int/∂u``; implicit integrators need it for nonlinear models
+    (without it they raise :class:`CapabilityError`, or use the documented alternative
+    ``newton="initial"``, a modified Newton iteration on the model's ``stiffness``).
+``"critical_time_step"`` (:class:`SupportsCriticalTimeStep`)
+    an element estimate of the explicit stable step in the current configuration, used by the
+    :class:`~arlequin.integrators.CriticalFraction` controller to follow a changing
+    configuration.
+
+State at quadrature points is an immutable object returned by ``internal_force`` as a *trial*
+state and committed by the integrator only once the step is accepted; the model never mutates
+it, so that a step can be redone from the committed state.
+
+Constraints
+-----------
+Equality rows ``B u = g(t)`` are :class:`arlequin.system.LinearConstraint` records. Rows whose
+active set is decided inside each time step (contact) follow :class:`UnilateralConstraint`: the
+constraint object holds only its configuration; its state lives in immutable records
+(:class:`ConstraintState` between steps, :class:`ConstraintTrial` during a step's status
+iterations) that the integrator passes in and commits. See the protocol for the calling sequence.
+
+Sign convention (every constraint): the force a constraint exerts on the system is ``−Bᵀλ`` (N)
+with ``λ`` the multiplier reported by the integrators, as in the static saddle point
+``K u + Bᵀλ = f``.
+
+Units are SI throughout (m, kg, s, Pa, N, J).
+"""
+
+from __future__ import annotations
+
+from typing import Any, Protocol, runtime_checkable
+
+import numpy as np
+
+__all__ = [
+    "CAPABILITIES",
+    "CapabilityError",
+    "ConstraintError",
+    "ConstraintState",
+    "ConstraintTrial",
+    "ContractError",
+    "DynamicModel",
+    "Model",
+    "SimulationError",
+    "StateError",
+    "SupportsCriticalTimeStep",
+    "SupportsTangent",
+    "UnilateralConstraint",
+    "capabilities",
+    "check_protocol",
+    "is_linear",
+    "is_unilateral",
+    "require",
+]
+
+
+# ---------------------------------------------------------------------------------------------
+# errors shared by the core and the models
+# ---------------------------------------------------------------------------------------------
+class StateError(ValueError):
+    """A model's state became invalid during a run (an inverted cell, a failed return mapping).
+
+    Models raise subclasses of it from ``internal_force``; the integrators turn it into a
+    :class:`SimulationError` naming the step and the time, and keep what was recorded until then.
+    """
+
+
+class SimulationError(ValueError):
+    """A run failed (non-finite values, an invalid model state, a Newton failure...).
+
+    Attributes
+    ----------
+    step : int
+        Index of the failed step (1 for the first step).
+    time : float
+        Time (s) the failed step was to reach.
+    result : DynamicResult or None
+        What was recorded until then (set by :func:`arlequin.integrators.solve`).
+    """
+
+    def __init__(self, message: str, step: int, time: float) -> None:
+        super().__init__(message)
+        self.step = int(step)
+        self.time = float(time)
+        self.result: Any = None
+
+
+class ConstraintError(ValueError):
+    """The constraint rows cannot be enforced (linearly dependent rows, zero masses...)."""
+
+
+class CapabilityError(ValueError):
+    """A model lacks an optional capability that the requested computation needs."""
+
+
+class ContractError(ValueError):
+    """An object is used as a model or a constraint but lacks members of its protocol."""
+
+
+# ---------------------------------------------------------------------------------------------
+# models
+# ---------------------------------------------------------------------------------------------
+@runtime_checkable
+class DynamicModel(Protocol):
+    """What the integrators call on a model (one block term of a coupled system).
+
+    Attributes
+    ----------
+    n_dofs : int
+        Number of degrees of freedom (dofs interleaved by node: ``n_components * node + c``).
+    is_linear : bool
+        True if ``internal_force(u) = stiffness() @ u`` for every ``u`` (the integrators then use
+        the assembled stiffness and never call ``internal_force``).
+
+    Notes
+    -----
+    Optional members: ``n_components`` (default 1) and ``initial_state(weight)`` (default None:
+    the first ``internal_force`` call gets ``state=None``).
+    """
+
+    n_dofs: int
+    is_linear: bool
+
+    def mass(self, weight: Any = None, lumped: bool = False) -> Any:
+        """Weighted mass ∫ α ρ u·v (kg): sparse (n_dofs, n_dofs), or its row sums when lumped."""
+
+    def stiffness(self, weight: Any = None) -> Any:
+        """Weighted stiffness (N/m), sparse (n_dofs, n_dofs); the small-strain (initial) tangent
+        of a nonlinear model, used for stable-step estimates."""
+
+    def internal_force(
+        self, u: np.ndarray, state: Any = None, weight: Any = None
+    ) -> tuple[np.ndarray, Any]:
+        """Internal force (N), shape (n_dofs,), and the trial state at displacement u (m)."""
+
+
+@runtime_checkable
+class Model(DynamicModel, Protocol):
+    """What an :class:`~arlequin.problem.ArlequinProblem` calls on a model.
+
+    Attributes
+    ----------
+    mesh : skfem.Mesh
+        The reference mesh (m), first order (P1 or Q1 cells).
+    kind : str
+        Kinematics: ``"1d"``, ``"plane_strain"``, ``"plane_stress"``, ``"axisymmetric"`` or
+        ``"3d"``; the coarse model and its patches must share it.
+    n_components : int
+        Displacement components per node.
+    """
+
+    mesh: Any
+    kind: str
+    n_components: int
+
+    def scalar_basis(self) -> Any:
+        """Scalar first-order ``skfem.Basis`` with the model's quadrature: weights are evaluated
+        at its quadrature points, shape (n_elems, n_qp)."""
+
+    def with_mesh(self, mesh: Any) -> Model:
+        """The same material and kinematics on another mesh (overlap integration meshes)."""
+
+    def initial_state(self, weight: Any = None) -> Any:
+        """State at the quadrature points before the first step (None for stateless models)."""
+
+    def body_force_vector(self, force: Any, weight: Any = None) -> np.ndarray:
+        """Load vector ∫ α f·v (N), shape (n_dofs,), of a body force density f (N/m³)."""
+
+    def traction_vector(self, facets: np.ndarray, traction: Any, weight: Any = None) -> np.ndarray:
+        """Load vector ∫ α t·v (N), shape (n_dofs,), of a traction t (Pa) on boundary facets."""
+
+
+@runtime_checkable
+class SupportsTangent(Protocol):
+    """Capability ``"tangent"``: the consistent tangent of ``internal_force``."""
+
+    def tangent(self, u: np.ndarray, state: Any = None, weight: Any = None) -> Any:
+        """∂f_int/∂u (N/m) at u from the committed state, sparse (n_dofs, n_dofs)."""
+
+
+@runtime_checkable
+class SupportsCriticalTimeStep(Protocol):
+    """Capability ``"critical_time_step"``: explicit stable-step estimate in a configuration."""
+
+    def critical_time_step(self, u: np.ndarray, state: Any = None) -> float:
+        """An estimate (s) of the critical step of central differences with the lumped mass at
+        displacement u (m), never larger than the true value of the model alone (weight 1)."""
+
+
+#: The optional capabilities and their protocols.
+CAPABILITIES: dict[str, type] = {
+    "tangent": SupportsTangent,
+    "critical_time_step": SupportsCriticalTimeStep,
+}
+
+
+def capabilities(model: Any) -> frozenset[str]:
+    """The optional capabilities a model declares (the protocols of :data:`CAPABILITIES` it
+    implements)."""
+    return frozenset(name for name, proto in CAPABILITIES.items() if isinstance(model, proto))
+
+
+def require(model: Any, capability: str, what: str) -> None:
+    """Raise :class:`CapabilityError` naming the model if it lacks ``capability``.
+
+    Parameters
+    ----------
+    model : object
+    capability : str
+        A key of :data:`CAPABILITIES`.
+    what : str
+        The computation that needs it (for the message).
+    """
+    if capability not in CAPABILITIES:
+        raise ValueError(f"unknown capability {capability!r}; known: {sorted(CAPABILITIES)}")
+    if capability not in capabilities(model):
+        raise CapabilityError(
+            f"{what} needs the {capability!r} capability, which model "
+            f"{type(model).__name__} does not provide"
+        )
+
+
+def check_protocol(obj: Any, protocol: type, what: str) -> None:
+    """Raise :class:`ContractError` naming the members of ``protocol`` that ``obj`` lacks.
+
+    Parameters
+    ----------
+    obj : object
+    protocol : type
+        A protocol of this module (:class:`Model`, :class:`DynamicModel`,
+        :class:`UnilateralConstraint`...).
+    what : str
+        What ``obj`` is used as (for the message), e.g. ``"the coarse model"``.
+    """
+    if isinstance(obj, protocol):
+        return
+    members = [
+        m
+        for klass in protocol.__mro__
+        if klass not in (object, Protocol) and klass.__name__ != "Generic"
+        for m in getattr(klass, "__annotations__", {}).keys() | vars(klass).keys()
+        if not m.startswith("_")
+    ]
+    missing = sorted({m for m in members if not hasattr(obj, m)})
+    raise ContractError(
+        f"{what} is a {type(obj).__name__}, which lacks {', '.join(missing)} of the "
+        f"{protocol.__name__} protocol (arlequin.contract)"
+    )
+
+
+def is_linear(model: Any) -> bool:
+    """The model's declared ``is_linear`` flag.
+
+    Raises
+    ------
+    CapabilityError
+        If the model does not declare it (the integrators never guess linearity).
+    """
+    flag = getattr(model, "is_linear", None)
+    if flag is None:
+        raise CapabilityError(
+            f"model {type(model).__name__} does not declare is_linear (True if its internal "
+            "force is stiffness() @ u, False otherwise): see arlequin.contract.DynamicModel"
+        )
+    return bool(flag)
+
+
+# ---------------------------------------------------------------------------------------------
+# unilateral constraints (contact)
+# ---------------------------------------------------------------------------------------------
+@runtime_checkable
+class ConstraintState(Protocol):
+    """Committed state of a unilateral constraint between steps (immutable).
+
+    Attributes
+    ----------
+    active : ndarray of bool, shape (m,)
+        Statuses of the candidate rows after the last accepted step.
+    work : float
+        Accumulated work of the constraint forces (J).
+    record : object or None
+        The per-step record of the last accepted step (None before the first), for histories.
+    """
+
+    active: np.ndarray
+    work: float
+    record: Any
+
+
+@runtime_checkable
+class ConstraintTrial(Protocol):
+    """A unilateral constraint inside one step's status iterations (immutable).
+
+    Attributes
+    ----------
+    active : ndarray of bool, shape (m,)
+        Current statuses: active rows are enforced as equalities at the constraint's level.
+    matrix : scipy.sparse.csr_matrix, shape (m, n)
+        Candidate rows in the configuration of the step.
+    rhs : ndarray, shape (m,)
+        Right-hand side of the rows (m for displacement rows, m/s for velocity rows) at the
+        end of the step.
+    changed : bool
+        Whether the last :meth:`UnilateralConstraint.update_status` changed a status.
+    iterations : int
+        Status updates made in this step.
+    """
+
+    active: np.ndarray
+    matrix: Any
+    rhs: np.ndarray
+    changed: bool
+    iterations: int
+
+
+@runtime_checkable
+class UnilateralConstraint(Protocol):
+    """Rows whose active set is decided inside each time step (the level-set contact model).
+
+    Calling sequence of one step (the integrator drives it; the constraint keeps no state)::
+
+        trial = c.begin_step(state, t, dt, u, v)       # geometry, statuses guess
+        loop:   solve with trial.active rows enforced (trial.matrix, trial.rhs)
+                trial = c.update_status(trial, u_pred, v_pred, multipliers)
+                until not trial.changed (or the cap of iterations)
+        state = c.commit(state, trial, t=..., u=..., v_before=..., v_after=...,
+                         multipliers=..., impulse=...)
+
+    A step that fails is simply not committed: the constraint's previous state is unchanged, so
+    the step can be redone (with another step size) and an integrator restarted from a saved
+    state.
+
+    Attributes
+    ----------
+    name : str
+        Name in the multiplier histories.
+    level : {"velocity", "displacement"}
+        An active row enforces ``G v = rhs`` on the end-of-step velocity, or ``G u = rhs``.
+    kind : str
+        Reporting group of its work (``"contact"``).
+    max_iterations : int
+        Cap on the status iterations of one step.
+    n_rows : int
+        Number of candidate rows m.
+    """
+
+    name: str
+    level: str
+    kind: str
+    max_iterations: int
+
+    @property
+    def n_rows(self) -> int:
+        """Number of candidate rows m."""
+
+    def initial_state(self, u: np.ndarray, v: np.ndarray) -> ConstraintState:
+        """The state before the first step at displacement u (m) and velocity v (m/s)."""
+
+    def begin_step(
+        self, state: ConstraintState, t: float, dt: float, u: np.ndarray, v: np.ndarray
+    ) -> ConstraintTrial:
+        """Start a step from time t (s) of size dt (s) at u (m) and the step's free velocity v
+        (m/s): rows in the current configuration and a first guess of the statuses."""
+
+    def update_status(
+        self, trial: ConstraintTrial, u: np.ndarray, v: np.ndarray, multipliers: np.ndarray
+    ) -> ConstraintTrial:
+        """New statuses from the predicted end-of-step u (m), v (m/s) and the multipliers of all
+        candidate rows, shape (m,) (zero on inactive rows)."""
+
+    def commit(
+        self,
+        state: ConstraintState,
+        trial: ConstraintTrial,
+        *,
+        t: float,
+        u: np.ndarray,
+        v_before: np.ndarray,
+        v_after: np.ndarray,
+        multipliers: np.ndarray,
+        impulse: np.ndarray,
+    ) -> ConstraintState:
+        """The state after the accepted step ending at t (s).
+
+        ``multipliers`` (m,) are the step's reported multipliers; ``impulse`` (m,) is the time
+        integral of the multipliers over the step, ∫ λ dt (the explicit impulse, Δt λ for the
+        θ-scheme, Δt (λⁿ + λⁿ⁺¹)/2 for Newmark), so that the work of the constraint forces −Bᵀλ
+        taking the velocities from v_before to v_after (m/s) is −impulse·B (v_before + v_after)/2
+        (J), whatever the scheme."""
+
+
+def is_unilateral(constraint: Any) -> bool:
+    """Whether a constraint object follows the :class:`UnilateralConstraint` protocol."""
+    return isinstance(constraint, UnilateralConstraint)

@@ -1,0 +1,170 @@
+"""The two-bar impact's exact solution, the result of a run, and its errors against the exact.
+
+Two identical elastic bars (E, ρ, c = √(E/ρ)), touching at t = 0: interface velocity
+(v₀ + v₂)/2 and contact pressure ρc(v₀ − v₂)/2 during the contact, which lasts 2 L_min / c; then
+the velocities are exchanged (SI units).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..io import JsonResult
+
+__all__ = ["JSON_KEYS", "TwoBarsResult", "exact_two_bars", "impact_metrics"]
+
+JSON_KEYS = (
+    "t",
+    "interface_velocity",
+    "contact_pressure",
+    "kinetic",
+    "internal",
+    "total_energy",
+    "contact_work",
+    "final_velocities",
+    "contact_duration",
+    "dt",
+    "fixed_point_iterations",
+)
+
+
+@dataclass
+class TwoBarsResult(JsonResult):
+    """Time histories of one impact run (SI units).
+
+    Attributes
+    ----------
+    t : ndarray, shape (n_rec,)
+        Times (s), from 0.
+    interface_velocity : ndarray, shape (n_rec,)
+        Velocity of bar 2's contact node (m/s) (the bar's for the wall).
+    contact_pressure : ndarray, shape (n_rec,)
+        −λ_v (Pa).
+    kinetic, internal, total_energy : ndarray, shape (n_rec,)
+        Kinetic, strain and their sum (J).
+    contact_work : ndarray, shape (n_rec,)
+        Accumulated work of the contact forces (J), from the multipliers (≤ 0: dissipated).
+    final_velocities : list of float
+        Mass-weighted mean velocities of the bars at the end (m/s).
+    contact_duration : float
+        (last − first record with λ_v ≠ 0) + Δt (s).
+    dt : float
+        Time step (s).
+    fixed_point_iterations : ndarray of int, shape (n_rec,)
+        Status iterations of the step ending at each record (0 at t = 0 for implicit schemes).
+    method : str
+        ``"levelset"``, ``"newmark-trapezoidal"`` or ``"newmark-hht"``.
+    exact : dict
+        Exact interface velocity (m/s), pressure (Pa), duration (s), final velocities (m/s).
+    newmark : TwoBarsResult or None
+        The baseline run of ``method="both"``.
+    dynamic : DynamicResult
+        The integrator's result (with the fields u, v at every step).
+    """
+
+    t: np.ndarray
+    interface_velocity: np.ndarray
+    contact_pressure: np.ndarray
+    kinetic: np.ndarray
+    internal: np.ndarray
+    total_energy: np.ndarray
+    contact_work: np.ndarray
+    final_velocities: list[float]
+    contact_duration: float
+    dt: float
+    fixed_point_iterations: np.ndarray
+    method: str = "levelset"
+    integrator: str = "theta"
+    exact: dict[str, Any] = field(default_factory=dict)
+    config: dict[str, Any] = field(default_factory=dict)
+    n_status_failures: int = 0
+    newmark: TwoBarsResult | None = None
+    dynamic: Any = field(default=None, repr=False)
+
+    json_keys = JSON_KEYS
+
+    def to_json(self) -> dict[str, Any]:
+        """The JSON document of the CLI: exactly :data:`JSON_KEYS` (+ ``"newmark"``)."""
+        out = super().to_json()
+        if self.newmark is not None:
+            out["newmark"] = self.newmark.to_json()
+        return out
+
+    def metrics(self) -> dict[str, float]:
+        """The Must-show figures against :attr:`exact` (see :func:`impact_metrics`)."""
+        return impact_metrics(self)
+
+    def summary(self) -> str:
+        m = self.metrics()
+        text = (
+            f"{self.method} ({self.integrator}), dt = {self.dt:.4e} s: interface velocity rms "
+            f"error {m['velocity_rms_error']:.3e}, pressure rms error "
+            f"{m['pressure_rms_error']:.3e}, "
+            f"duration {self.contact_duration:.6e} s (exact {self.exact['duration']:.6e} s, "
+            f"{m['duration_error_steps']:+.2f} steps), final velocities "
+            f"{[round(v, 6) for v in self.final_velocities]}, energy lost {m['energy_loss']:.3e}"
+        )
+        if self.newmark is not None:
+            text += "\n" + self.newmark.summary()
+        return text
+
+
+def exact_two_bars(
+    lengths=(1.0, 1.0), young=210e9, density=7850.0, velocity=1.0, velocity2=0.0
+) -> dict[str, Any]:
+    """Exact solution of the two-bar impact (same material, bars touching at t = 0).
+
+    Returns
+    -------
+    dict
+        ``interface_velocity`` (m/s), ``pressure`` (Pa), ``duration`` (s),
+        ``final_velocities`` (m/s, mass-weighted means), ``c`` (m/s).
+    """
+    c = math.sqrt(young / density)
+    l1, l2 = (float(x) for x in lengths)
+    lmin = min(l1, l2)
+    dv = velocity - velocity2
+    # impulse per unit area: ρ c dv/2 during 2 L_min / c -> ρ L_min dv
+    return {
+        "interface_velocity": 0.5 * (velocity + velocity2),
+        "pressure": 0.5 * density * c * dv,
+        "duration": 2.0 * lmin / c,
+        "final_velocities": [velocity - lmin * dv / l1, velocity2 + lmin * dv / l2],
+        "c": c,
+    }
+
+
+def impact_metrics(result: TwoBarsResult, skip: int = 2) -> dict[str, float]:
+    """Errors of an impact run against its exact solution.
+
+    Over the records in contact (λ_v ≠ 0) except the first ``skip`` and the last ``skip``:
+    rms of (interface velocity − exact)/|exact| and of (pressure − exact)/exact. Also the
+    duration error in steps, the final-velocity error / v₀, and the energy lost
+    (E(0) − E(end))/E(0).
+    """
+    ex = result.exact
+    act = np.nonzero(result.contact_pressure != 0.0)[0]
+    out = {"velocity_rms_error": math.nan, "pressure_rms_error": math.nan}
+    if act.size > 2 * skip:
+        sl = slice(act[0] + skip, act[-1] - skip + 1)
+        vi = result.interface_velocity[sl]
+        pr = result.contact_pressure[sl]
+        vref = ex["interface_velocity"]
+        scale_v = abs(vref) if vref != 0.0 else abs(ex["velocity_scale"])
+        out["velocity_rms_error"] = float(np.sqrt(np.mean((vi - vref) ** 2)) / scale_v)
+        p_err = np.sqrt(np.mean((pr - ex["pressure"]) ** 2))
+        out["pressure_rms_error"] = float(p_err / ex["pressure"])
+    out["duration_error_steps"] = (result.contact_duration - ex["duration"]) / result.dt
+    fin = np.asarray(result.final_velocities) - np.asarray(ex["final_velocities"])
+    out["final_velocity_error"] = float(np.max(np.abs(fin)) / abs(ex["velocity_scale"]))
+    e = result.total_energy
+    out["energy_loss"] = float((e[0] - e[-1]) / e[0])
+    out["max_energy_gain"] = float((np.max(e) - e[0]) / e[0])
+    w = result.contact_work
+    out["contact_work"] = float(w[-1])
+    out["balance_error"] = float(np.max(np.abs(e - e[0] - w)) / e[0])
+    return out

@@ -1,0 +1,30 @@
+"""Results on disk: results folders, time histories, field series (XDMF + HDF5 via meshio).
+
+``folder`` (:class:`ResultsFolder`: results.json, files), ``history`` (CSV written row by row),
+``fields`` (XDMF series written frame by frame), ``layout`` (system vectors -> mesh fields),
+``run`` (writers of dynamic and static runs). The core's integrators never import this package;
+demos and the CLI do.
+"""
+
+from .fields import FieldSeries, meshio_mesh, read_series
+from .folder import RESULTS_JSON, JsonResult, ResultsFolder, environment, jsonable
+from .history import HistoryCSV, read_history
+from .layout import BlockFields, FieldLayout
+from .run import DynamicRunWriter, write_static
+
+__all__ = [
+    "RESULTS_JSON",
+    "BlockFields",
+    "DynamicRunWriter",
+    "FieldLayout",
+    "FieldSeries",
+    "HistoryCSV",
+    "JsonResult",
+    "ResultsFolder",
+    "environment",
+    "jsonable",
+    "meshio_mesh",
+    "read_history",
+    "read_series",
+    "write_static",
+]

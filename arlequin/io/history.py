@@ -1,0 +1,69 @@
+"""Time histories as CSV, one row per record, written and flushed as the run goes."""
+
+from __future__ import annotations
+
+import csv
+import os
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["HistoryCSV", "read_history"]
+
+
+class HistoryCSV:
+    """A CSV file of named columns (the header carries the units: ``name [unit]``).
+
+    Parameters
+    ----------
+    path : str or Path
+    columns : sequence of str
+        Column names, in order.
+    units : mapping, optional
+        Column name -> unit string (SI), shown in the header.
+    """
+
+    def __init__(
+        self,
+        path: str | os.PathLike,
+        columns: Sequence[str],
+        units: Mapping[str, str] | None = None,
+    ) -> None:
+        self.path = Path(path)
+        self.columns = list(columns)
+        units = dict(units or {})
+        self._fh = open(self.path, "w", newline="", encoding="utf-8")
+        self._csv = csv.writer(self._fh)
+        self._csv.writerow([f"{c} [{units[c]}]" if units.get(c) else c for c in self.columns])
+        self._fh.flush()
+        self.n_rows = 0
+
+    def append(self, row: Mapping[str, float]) -> None:
+        """Write one row (missing columns are left empty) and flush it to disk."""
+        self._csv.writerow([_text(row[c]) if c in row else "" for c in self.columns])
+        self._fh.flush()
+        self.n_rows += 1
+
+    def close(self) -> None:
+        if not self._fh.closed:
+            self._fh.close()
+
+
+def _text(value) -> str:
+    """Integers (step counts) as integers, every other number with all its digits."""
+    if isinstance(value, (int, np.integer)) and not isinstance(value, bool):
+        return str(int(value))
+    return repr(float(value))
+
+
+def read_history(path: str | os.PathLike) -> dict[str, list[float]]:
+    """Columns of a history file by name (units stripped from the header)."""
+    with open(path, newline="", encoding="utf-8") as fh:
+        reader = csv.reader(fh)
+        header = [h.split(" [")[0] for h in next(reader)]
+        cols: dict[str, list[float]] = {h: [] for h in header}
+        for row in reader:
+            for h, v in zip(header, row):
+                cols[h].append(float(v) if v != "" else float("nan"))
+    return cols

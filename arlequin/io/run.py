@@ -1,0 +1,113 @@
+"""Writers of runs into a results folder: dynamic runs as they go, static solutions at once.
+
+:class:`DynamicRunWriter` is a listener for :func:`arlequin.integrators.solve` (``on_record``):
+at every record it appends a history row (time, step, energies and works per block, the energy
+balance) and, at the frame times, a frame of every block's field series.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from .folder import ResultsFolder
+from .layout import FieldLayout
+
+__all__ = ["DynamicRunWriter", "write_static"]
+
+_ENERGIES = ("kinetic", "strain", "external_work", "coupling_work", "constraint_work")
+
+
+class DynamicRunWriter:
+    """Writes a dynamic run into a results folder as it goes.
+
+    Parameters
+    ----------
+    folder : ResultsFolder
+    system : CoupledSystem
+    layout : FieldLayout, optional
+        Default: :meth:`FieldLayout.of_system`.
+    frame_times : sequence of float, optional
+        Times (s) of the field frames: a frame is written at the first record at or after each
+        (default: every record). To have the frames exactly at these times, give them to
+        :func:`~arlequin.integrators.solve` as ``t_eval`` too (the records are then only there).
+    prefix : str
+        Prefix of the file names (several runs in one folder).
+    """
+
+    def __init__(
+        self,
+        folder: ResultsFolder,
+        system: Any,
+        layout: FieldLayout | None = None,
+        frame_times: Sequence[float] | None = None,
+        prefix: str = "",
+    ) -> None:
+        self.system = system
+        self.layout = FieldLayout.of_system(system) if layout is None else layout
+        names = [b.name for b in system.blocks]
+        self.columns = ["t", "dt", "step", "energy", "balance"] + [
+            f"{k}:{n}" for k in _ENERGIES for n in names
+        ]
+        units = {c: "J" for c in self.columns}
+        units.update({"t": "s", "dt": "s", "step": "1"})
+        self.history = folder.history(self.columns, units, name=f"{prefix}history")
+        self.series = {
+            bf.name: folder.series(f"{prefix}{bf.name}", bf.mesh) for bf in self.layout.blocks
+        }
+        folder.meta.setdefault("field_units", {}).update(self.layout.units)
+        self.frame_times = None if frame_times is None else np.sort(np.asarray(frame_times))
+        self._next = 0
+        self._e0: float | None = None
+        self.frames_written: list[float] = []
+
+    def __call__(self, integ: Any) -> None:
+        e = integ.energies()
+        row = {"t": integ.t, "dt": integ.step_size or 0.0, "step": integ.step_count}
+        total = sum(e["kinetic"].values()) + sum(e["strain"].values())
+        works = sum(sum(e[k].values()) for k in _ENERGIES[2:])
+        if self._e0 is None:
+            self._e0 = total
+        row["energy"] = total
+        row["balance"] = total - self._e0 - works
+        for k in _ENERGIES:
+            for name, val in e[k].items():
+                row[f"{k}:{name}"] = val
+        self.history.append(row)
+        if self._due(integ.t, integ.step_size):
+            self.write_frame(integ.t, integ.u, integ.v, integ.multipliers)
+
+    def _due(self, t: float, dt: float | None) -> bool:
+        if self.frame_times is None:
+            return True
+        tol = 1e-12 * (dt or 1.0)
+        due = False
+        while self._next < self.frame_times.size and t >= self.frame_times[self._next] - tol:
+            self._next += 1
+            due = True
+        return due
+
+    def write_frame(self, t, u, v=None, multipliers=None) -> None:
+        """One frame of every block at time t (s)."""
+        for name, (point, cell) in self.layout.frame(self.system.dofmap, u, v, multipliers).items():
+            self.series[name].write(t, point, cell)
+        self.frames_written.append(float(t))
+
+
+def write_static(folder: ResultsFolder, system: Any, result: Any, layout: FieldLayout) -> None:
+    """Write a static solution: a one-row history (strain energies, residual) and one frame."""
+    names = [b.name for b in system.blocks]
+    cols = ["t", "residual"] + [f"strain:{n}" for n in names]
+    units = {c: "J" for c in cols}
+    units.update({"t": "s", "residual": "1"})
+    hist = folder.history(cols, units)
+    row: dict[str, float] = {"t": 0.0, "residual": result.residual}
+    row.update({f"strain:{n}": result.strain_energy[n] for n in names})
+    hist.append(row)
+    folder.meta.setdefault("field_units", {}).update(layout.units)
+    for bf in layout.blocks:
+        series = folder.series(bf.name, bf.mesh)
+        point, cell = layout.frame(system.dofmap, result.u, None, result.multipliers)[bf.name]
+        series.write(0.0, point, cell)

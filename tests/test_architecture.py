@@ -1,0 +1,173 @@
+"""The layering of docs/architecture.md, read from the source: who imports whom, cycles, sizes.
+
+Rules (the table of docs/architecture.md):
+
+* ``arlequin/`` outside ``demos/`` and ``cli.py`` never imports the models;
+* ``models/`` imports from ``arlequin`` only the contract and the pure helpers
+  (:data:`MODEL_ALLOWED`);
+* the integrators never import the results layer (``arlequin.io``) nor the problem set-up;
+* no import cycle among the package's modules (each module is a node; ``from . import x`` and
+  ``from .x import y`` are edges to the module x; imports for annotations only, under
+  ``if TYPE_CHECKING:``, are not edges);
+* no module above 500 lines unless its docstring says why (a line starting ``Size:``).
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import arlequin
+
+ROOT = Path(arlequin.__file__).resolve().parent  # arlequin/
+MODELS = ROOT.parent / "models"
+
+#: What models may import from the core (besides themselves): the contract and pure helpers.
+MODEL_ALLOWED = {"arlequin.contract", "arlequin.dofs", "arlequin.reference", "arlequin.geometry"}
+
+
+def module_name(path: Path) -> str:
+    if path.is_relative_to(MODELS):
+        parts = ("arlequin", "models", *path.relative_to(MODELS).with_suffix("").parts)
+    else:
+        parts = ("arlequin", *path.relative_to(ROOT).with_suffix("").parts)
+    if parts[-1] == "__init__":
+        parts = parts[:-1]
+    return ".".join(parts)
+
+
+def all_modules() -> dict[str, Path]:
+    files = list(ROOT.rglob("*.py")) + list(MODELS.rglob("*.py"))
+    return {module_name(p): p for p in files}
+
+
+def imports_of(path: Path, name: str, known: set[str]) -> set[str]:
+    """Modules of the package imported by one file (resolved to known module names)."""
+    is_pkg = path.name == "__init__.py"
+    package = name if is_pkg else name.rsplit(".", 1)[0]
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    # imports under ``if TYPE_CHECKING:`` exist for annotations only, never at run time
+    for node in ast.walk(tree):
+        if isinstance(node, ast.If) and getattr(node.test, "id", None) == "TYPE_CHECKING":
+            node.body = []
+    out: set[str] = set()
+    for node in ast.walk(tree):
+        targets = []
+        if isinstance(node, ast.Import):
+            targets = [a.name for a in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")
+                base = base[: len(base) - (node.level - 1)]
+                mod = ".".join(base + ([node.module] if node.module else []))
+            else:
+                mod = node.module or ""
+            targets = [mod] + [f"{mod}.{a.name}" for a in node.names]
+        for t in targets:
+            if t in known:
+                out.add(t)
+            elif t.rsplit(".", 1)[0] in known and t.startswith("arlequin"):
+                out.add(t.rsplit(".", 1)[0])
+    out.discard(name)
+    return out
+
+
+def graph() -> dict[str, set[str]]:
+    mods = all_modules()
+    known = set(mods)
+    return {name: imports_of(path, name, known) for name, path in mods.items()}
+
+
+def violations(importer, forbidden) -> list[tuple[str, str]]:
+    """(module, dependency) edges where ``importer(module)`` and ``forbidden(dependency)``."""
+    return [(m, d) for m, deps in graph().items() if importer(m) for d in deps if forbidden(d)]
+
+
+def test_core_outside_demos_and_cli_never_imports_models():
+    bad = violations(
+        lambda m: not m.startswith(("arlequin.models", "arlequin.demos")) and m != "arlequin.cli",
+        lambda d: d.startswith("arlequin.models"),
+    )
+    assert not bad, bad
+
+
+def test_models_import_only_the_contract_and_pure_helpers():
+    bad = violations(
+        lambda m: m.startswith("arlequin.models"),
+        lambda d: not d.startswith("arlequin.models") and d not in MODEL_ALLOWED,
+    )
+    assert not bad, bad
+
+
+def test_integrators_do_not_import_the_results_layer_or_the_problem():
+    bad = violations(
+        lambda m: m.startswith("arlequin.integrators"),
+        lambda d: d.startswith(
+            ("arlequin.io", "arlequin.problem", "arlequin.gluing", "arlequin.demos")
+        ),
+    )
+    assert not bad, bad
+
+
+def test_results_layer_imports_only_the_dof_layout():
+    bad = violations(
+        lambda m: m.startswith("arlequin.io"),
+        lambda d: not d.startswith("arlequin.io") and d != "arlequin.dofs",
+    )
+    assert not bad, bad
+
+
+def test_no_import_cycle():
+    g = graph()
+    state: dict[str, int] = {}
+    stack: list[str] = []
+    cycles: list[list[str]] = []
+
+    def visit(n: str) -> None:
+        state[n] = 1
+        stack.append(n)
+        for d in sorted(g[n]):
+            if state.get(d) == 1:
+                cycles.append([*stack[stack.index(d) :], d])
+            elif d not in state:
+                visit(d)
+        stack.pop()
+        state[n] = 2
+
+    for n in sorted(g):
+        if n not in state:
+            visit(n)
+    assert not cycles, cycles
+
+
+def test_modules_stay_small_or_say_why():
+    long = []
+    for name, path in all_modules().items():
+        n_lines = len(path.read_text(encoding="utf-8").splitlines())
+        if n_lines <= 500:
+            continue
+        doc = ast.get_docstring(ast.parse(path.read_text(encoding="utf-8"))) or ""
+        if not any(line.startswith("Size:") for line in doc.splitlines()):
+            long.append((name, n_lines))
+    assert not long, long
+
+
+def test_the_architecture_page_names_every_module():
+    page = (ROOT.parent / "docs" / "architecture.md").read_text(encoding="utf-8")
+    missing = [
+        name
+        for name, path in all_modules().items()
+        if path.name != "__init__.py" and f"{path.stem}.py" not in page
+    ]
+    assert not missing, missing
+
+
+def test_every_subpackage_is_shipped():
+    """pyproject.toml lists every package (a missing one imports in the tree, not installed)."""
+    import tomllib
+
+    cfg = tomllib.loads((ROOT.parent / "pyproject.toml").read_text(encoding="utf-8"))
+    shipped = set(cfg["tool"]["setuptools"]["packages"])
+    found = {module_name(p.parent / "__init__.py") for p in ROOT.rglob("__init__.py")}
+    found.add("arlequin.models")
+    assert found <= shipped, found - shipped
