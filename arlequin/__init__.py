@@ -19,6 +19,36 @@ evaluate_field, locate_points   fields at points, bounded point locator
 errors                          ``ValueError`` subclasses naming the quantity and its value
 """
 
+import importlib.abc as _abc
+import importlib.util as _util
+import sys as _sys
+from pathlib import Path as _Path
+
+
+def _map_models_folder() -> None:
+    """Make ``arlequin.models`` the sibling ``models/`` folder when this package is the source
+    tree (``arlequin/`` next to ``models/``, e.g. run from the repository root after
+    ``pip install .``, where the local folder shadows the installed package). Installed
+    packages hold ``arlequin/models/`` themselves and are left alone."""
+    here = _Path(__file__).resolve().parent
+    source = here.parent / "models"
+    if (here / "models").is_dir() or not (source / "__init__.py").is_file():
+        return
+
+    class _ModelsFinder(_abc.MetaPathFinder):
+        def find_spec(self, name, path=None, target=None):
+            if name != "arlequin.models":
+                return None
+            return _util.spec_from_file_location(
+                name, source / "__init__.py", submodule_search_locations=[str(source)]
+            )
+
+    if not any(type(f).__name__ == "_ModelsFinder" for f in _sys.meta_path):
+        _sys.meta_path.insert(0, _ModelsFinder())
+
+
+_map_models_folder()
+
 from .contract import (
     CapabilityError,
     ConstraintError,
@@ -29,11 +59,12 @@ from .contract import (
 from .coupling import MediatorError
 from .dofs import DofMap
 from .fields import evaluate_field
-from .gluing import Patch, PatchCoupling
+from .gluing import ExactnessWarning, Patch, PatchCoupling
 from .integrators import DynamicResult, solve
 from .integrators.static import SingularSystemError, StaticResult, solve_static
 from .io import ResultsFolder
 from .locate import locate_points
+from .meshcheck import MeshError, check_mesh
 from .overlap import Overlap, OverlapError, build_overlap
 from .patches import refine_region
 from .problem import ArlequinProblem
@@ -50,7 +81,9 @@ __all__ = [
     "ContractError",
     "DofMap",
     "DynamicResult",
+    "ExactnessWarning",
     "MediatorError",
+    "MeshError",
     "Overlap",
     "OverlapError",
     "Patch",
@@ -63,6 +96,7 @@ __all__ = [
     "StaticResult",
     "WeightSumError",
     "build_overlap",
+    "check_mesh",
     "evaluate_field",
     "locate_points",
     "refine_region",

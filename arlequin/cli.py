@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import json
 import logging
+import math
 import os
 import sys
 from collections.abc import Sequence
@@ -18,7 +19,35 @@ from collections.abc import Sequence
 __all__ = ["main"]
 
 
+class NonFiniteResult(RuntimeError):
+    """A command computed a NaN or an infinite value (the run is reported as failed)."""
+
+
+def _non_finite(data, prefix: str = "") -> list[str]:
+    """Keys of non-finite numbers in a JSON-like document."""
+    out: list[str] = []
+    if isinstance(data, dict):
+        for k, v in data.items():
+            out += _non_finite(v, f"{prefix}{k}.")
+    elif isinstance(data, (list, tuple)):
+        for i, v in enumerate(data):
+            out += _non_finite(v, f"{prefix}{i}.")
+    elif isinstance(data, float) and not math.isfinite(data):
+        out.append(f"{prefix[:-1]}={data}")
+    elif isinstance(data, str) and data in ("nan", "inf", "-inf"):
+        out.append(f"{prefix[:-1]}={data}")
+    return out
+
+
+def _check_results(data: dict) -> None:
+    bad = _non_finite(data)
+    if bad:
+        shown = ", ".join(bad[:5]) + (f" and {len(bad) - 5} more" if len(bad) > 5 else "")
+        raise NonFiniteResult(f"the run produced non-finite results: {shown}")
+
+
 def _write_json(path: str | None, data: dict) -> None:
+    _check_results(data)
     if path:
         with open(path, "w", encoding="utf-8") as fh:
             json.dump(data, fh, indent=2)
@@ -55,6 +84,9 @@ def _cmd_patch_test(args: argparse.Namespace) -> int:
         mesh=args.mesh,
         seed=args.seed,
         out=args.out,
+        layout=args.layout,
+        ratio=args.ratio,
+        band_cells=args.band_cells,
     )
     print(result.summary())
     keys = ("max_error", "exact_residual", "n_coarse_dofs", "n_fine_dofs", "n_multipliers")
@@ -77,6 +109,16 @@ def _add_patch_test(sub) -> None:
     p.add_argument("--mediator", choices=["coarse", "fine"], default="coarse")
     p.add_argument("--mesh", choices=["nested", "nonnested"], default="nested")
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument(
+        "--layout",
+        choices=["random", "strip", "square"],
+        default="random",
+        help="random configuration, a strip spanning the domain, or an interior square (2D)",
+    )
+    p.add_argument("--ratio", type=int, default=4, help="coarse/fine size ratio (strip, square)")
+    p.add_argument(
+        "--band-cells", type=int, default=1, help="gluing band in coarse cells (strip, square)"
+    )
     p.add_argument("--json", metavar="PATH", default=None, help="write the results as JSON")
     _add_out(p)
     p.set_defaults(func=_cmd_patch_test)
@@ -218,9 +260,21 @@ def main(argv: Sequence[str] | None = None) -> int:
         for attr in ("json", "plot"):
             _check_writable(getattr(args, attr, None), f"--{attr}")
         return int(args.func(args) or 0)
-    except ValueError as exc:
+    except ValueError as exc:  # bad input (every input error of the library is a ValueError)
         print(f"arlequin {args.command}: error: {exc}", file=sys.stderr)
         return 2
+    except NonFiniteResult as exc:
+        print(f"arlequin {args.command}: failed: {exc}", file=sys.stderr)
+        return 1
+    except Exception as exc:  # a bug: say so in one line, the traceback with -v
+        if args.verbose:
+            raise
+        print(
+            f"arlequin {args.command}: internal error ({type(exc).__name__}: {exc}); rerun with "
+            "-v for the traceback and report it",
+            file=sys.stderr,
+        )
+        return 1
 
 
 if __name__ == "__main__":  # pragma: no cover

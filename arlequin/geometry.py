@@ -11,7 +11,14 @@ import numpy as np
 from scipy.spatial import cKDTree
 from skfem import Mesh, MeshHex
 
-__all__ = ["boundary_distance", "cyclic_quad_faces", "distance_to_facets", "facet_coordinates"]
+__all__ = [
+    "boundary_distance",
+    "cyclic_quad_faces",
+    "distance_to_facets",
+    "facet_coordinates",
+    "facet_normals",
+    "outward_normals",
+]
 
 
 def facet_coordinates(mesh: Mesh, facets: np.ndarray | None = None) -> np.ndarray:
@@ -162,3 +169,56 @@ def distance_to_facets(
 def boundary_distance(mesh: Mesh, points: np.ndarray) -> np.ndarray:
     """Distance (m) from points (dim, n) to the boundary of ``mesh``, shape (n,)."""
     return distance_to_facets(points, facet_coordinates(mesh))
+
+
+def facet_normals(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Unit normals (oriented by the vertex order) and measures of facets.
+
+    Parameters
+    ----------
+    x : ndarray, shape (dim, n_facets, n_vertices)
+        Facet vertex coordinates (m); quadrilateral faces in cyclic order.
+
+    Returns
+    -------
+    normals : ndarray, shape (dim, n_facets)
+    measures : ndarray, shape (n_facets,)
+        Length (2D), area (3D), 1 (1D points).
+    """
+    dim, nf, nv = x.shape
+    if dim == 1:
+        return np.ones((1, nf)), np.ones(nf)
+    if dim == 2:
+        t = x[:, :, 1] - x[:, :, 0]
+        n = np.stack([t[1], -t[0]])
+        ln = np.linalg.norm(n, axis=0)
+        return n / ln, ln
+    if nv == 3:
+        n = np.cross(x[:, :, 1] - x[:, :, 0], x[:, :, 2] - x[:, :, 0], axis=0)
+        ln = np.linalg.norm(n, axis=0)
+        return n / ln, 0.5 * ln
+    # quadrilateral: mean normal of the two diagonals' cross product; area of its two triangles
+    n = 0.5 * np.cross(x[:, :, 2] - x[:, :, 0], x[:, :, 3] - x[:, :, 1], axis=0)
+    e1, e2, e3 = (x[:, :, i] - x[:, :, 0] for i in (1, 2, 3))
+    a1 = 0.5 * np.linalg.norm(np.cross(e1, e2, axis=0), axis=0)
+    a2 = 0.5 * np.linalg.norm(np.cross(e2, e3, axis=0), axis=0)
+    return n / np.linalg.norm(n, axis=0), a1 + a2
+
+
+def outward_normals(mesh: Mesh, facets: np.ndarray) -> np.ndarray:
+    """Unit normals of boundary facets pointing out of the mesh, shape (dim, n_facets).
+
+    Oriented away from the centroid of the cell each facet belongs to (1D: ±1).
+    """
+    facets = np.asarray(facets, dtype=np.int64)
+    x = np.transpose(facet_coordinates(mesh, facets), (2, 0, 1))  # (dim, n_f, n_v)
+    mid = x.mean(axis=2)
+    cells = mesh.f2t[0, facets]
+    centroid = mesh.p[:, mesh.t[:, cells]].mean(axis=1)
+    if mesh.dim() == 1:
+        n = np.sign(mid - centroid)
+    else:
+        n, _ = facet_normals(x)
+    sign = np.sign(np.sum(n * (mid - centroid), axis=0))
+    sign[sign == 0.0] = 1.0
+    return n * sign

@@ -10,6 +10,7 @@ coupling matrices (:mod:`arlequin.coupling`). All quantities are SI.
 from __future__ import annotations
 
 import logging
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
@@ -17,16 +18,23 @@ from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
+from skfem import Basis
 
 from .contract import Model, check_protocol
 from .coupling import CouplingMatrices, MediatorError, coupling_matrices
-from .geometry import distance_to_facets, facet_coordinates
+from .geometry import distance_to_facets, facet_coordinates, outward_normals
 from .locate import cell_centroids, cell_sizes, locate_points
 from .overlap import Overlap, build_overlap
+from .reference import scalar_element_for
 from .system import BlockTerm
 from .weights import PartitionWeights, check_partition_of_unity, make_weights
 
-__all__ = ["Patch", "PatchCoupling"]
+__all__ = ["ExactnessWarning", "Patch", "PatchCoupling"]
+
+
+class ExactnessWarning(UserWarning):
+    """The patch breaks a documented exactness condition: a uniform stress state is not
+    reproduced exactly (the message names the condition and a setting that meets it)."""
 
 logger = logging.getLogger(__name__)
 
@@ -132,6 +140,78 @@ class PatchCoupling:
             patch.mediator,
             self.axisymmetric,
         )
+        self.exactness_failures = self._diagnose_exactness()
+        for failure in self.exactness_failures:
+            warnings.warn(f"{self.name}: {failure}", ExactnessWarning, stacklevel=3)
+
+    # ------------------------------------------------------------------ exactness
+    def _diagnose_exactness(self) -> list[str]:
+        """The exactness conditions of docs/theory.md this patch breaks ([] if none).
+
+        Condition A: a nested patch with the fine mediator (whose space contains the coarse one
+        on S_g), weights constant outside S_g. Condition B: ramp weights whose gradient ∇α_c is
+        one constant vector over the part of S_g each mediator function sees (straight bands,
+        no function meeting two bands), so that σ·∇α_c lies in the mediator space. User weights
+        are not checked (logged).
+        """
+        nested = self.overlap.method == "nested"
+        same_space = nested and self.fine_model.mesh.nelements == np.unique(
+            self.overlap.coarse_cells
+        ).size  # the patch is the coarse mesh itself: both mediators are the fine space
+        fine_mediator = self.patch.mediator == "fine" or same_space
+        if nested and fine_mediator:
+            return []  # condition A
+        name = type(self.weights).__name__
+        if name == "ConstantWeights":
+            return [
+                "constant weights reproduce a uniform stress exactly only on a nested patch "
+                "with the fine mediator (condition A of docs/theory.md; measured errors 1e-3 to "
+                "4e-2 otherwise): use weights='ramp' with straight bands, or mediator='fine' "
+                "on a nested patch"
+            ]
+        if name != "RampWeights":
+            logger.info("%s: exactness of user weights %s not checked", self.name, name)
+            return []
+        return self._diagnose_ramp()
+
+    def _diagnose_ramp(self) -> list[str]:
+        """Condition B for ramp weights: one weight gradient per mediator function."""
+        imesh = self.overlap.integration_mesh
+        cells = self.gluing_cells
+        basis = Basis(imesh, scalar_element_for(imesh), elements=cells, intorder=2)
+        nodal = self.weights.alpha_coarse(imesh.p, self._node_distance(imesh), self.gluing_width)
+        grad = np.asarray(basis.interpolate(np.asarray(nodal, dtype=float)).grad)  # (d, nc, nq)
+        scale = float(np.max(np.abs(grad))) if grad.size else 0.0
+        if scale == 0.0:
+            return []
+        coarse = self.patch.mediator == "coarse"
+        owner = self.overlap.coarse_cells[cells] if coarse else self.overlap.fine_cells[cells]
+        mesh = self.coarse_model.mesh if coarse else self.fine_model.mesh
+        nodes = mesh.t[:, owner]  # (n_v, n_gc): the mediator functions over each gluing cell
+        n_v, n_gc = nodes.shape
+        node_of = nodes.ravel()
+        cell_of = np.tile(np.arange(n_gc), n_v)
+        lo = np.full((grad.shape[0], mesh.nvertices), np.inf)
+        hi = np.full((grad.shape[0], mesh.nvertices), -np.inf)
+        g_min, g_max = grad.min(axis=2), grad.max(axis=2)  # (d, n_gc)
+        for i in range(grad.shape[0]):
+            np.minimum.at(lo[i], node_of, g_min[i, cell_of])
+            np.maximum.at(hi[i], node_of, g_max[i, cell_of])
+        spread = np.max(np.where(np.isfinite(lo), hi - lo, 0.0), axis=0)
+        bad = np.nonzero(spread > 1e-6 * scale)[0]
+        if bad.size == 0:
+            return []
+        worst = int(bad[np.argmax(spread[bad])])
+        x = ", ".join(f"{c:.4g}" for c in mesh.p[:, worst])
+        which = "coarse" if coarse else "fine"
+        return [
+            f"{bad.size} {which} mediator function(s) see different gradients of the ramp "
+            f"weight on the gluing zone (the worst at x = ({x}) m: the band turns a corner, is "
+            "curved, or one function meets two bands), so σ·∇α_c is not in the mediator space "
+            "(condition B of docs/theory.md) and a uniform stress is not reproduced exactly: "
+            "use mediator='fine' on a nested patch (condition A), or straight bands whose "
+            f"{which} mediator functions each meet a single band"
+        ]
 
     def default_h1_length(self) -> float:
         """Default H1 coupling length ℓ (m): the mean coarse cell size on the gluing zone.
@@ -160,13 +240,36 @@ class PatchCoupling:
         h = np.where(loc.cells >= 0, self._coarse_h[np.maximum(loc.cells, 0)], self._coarse_h.max())
         return dist <= self.patch.boundary_tol * h
 
+    def facets_on_coarse_boundary(self, mesh, facets: np.ndarray) -> np.ndarray:
+        """Which boundary facets of a patch-side mesh lie on the coarse boundary, (n_f,) bool.
+
+        A facet does when its midpoint is within ``boundary_tol`` × the local coarse cell size
+        h of the coarse boundary *and* the point at that distance beyond the midpoint, along
+        the facet's outward normal, lies outside the coarse mesh. The second test does not
+        depend on the patch's cell size: an interior facet that meets the coarse boundary at a
+        vertex (a strip patch spanning the domain) has its probe inside the coarse mesh
+        whatever the mesh ratio, and faceted curved boundaries (patch nodes projected onto the
+        true curve, off the coarse facets by much less than h) are still recognised.
+        """
+        facets = np.asarray(facets, dtype=np.int64)
+        mid = mesh.p[:, mesh.facets[:, facets]].mean(axis=1)
+        on = self.on_coarse_boundary(mid)
+        if not on.any():
+            return on
+        cmesh = self.coarse_model.mesh
+        near = np.nonzero(on)[0]
+        loc = locate_points(cmesh, mid[:, near], tol=max(self.patch.boundary_tol, 1e-6))
+        h = np.where(loc.cells >= 0, self._coarse_h[np.maximum(loc.cells, 0)], self._coarse_h.max())
+        probe = mid[:, near] + self.patch.boundary_tol * h * outward_normals(mesh, facets[near])
+        on[near] = ~locate_points(cmesh, probe, tol=0.0).inside
+        return on
+
     def _classify_boundary(self) -> None:
         fmesh = self.fine_model.mesh
         self._coarse_facets = facet_coordinates(self.coarse_model.mesh)
         self._coarse_h = cell_sizes(self.coarse_model.mesh)
         bfacets = fmesh.boundary_facets()
-        mid = fmesh.p[:, fmesh.facets[:, bfacets]].mean(axis=1)
-        on = self.on_coarse_boundary(mid)
+        on = self.facets_on_coarse_boundary(fmesh, bfacets)
         self.outer_facets = bfacets[on]
         self.interior_facets = bfacets[~on]
         self._interior_coords = facet_coordinates(fmesh, self.interior_facets)
@@ -337,8 +440,25 @@ class PatchCoupling:
         return BlockTerm(self.fine_model, self.alpha_fine)
 
     def integration_boundary_facets(self) -> np.ndarray:
-        """Boundary facets of the integration mesh that lie on the coarse mesh's boundary."""
+        """Boundary facets of the integration mesh that lie on the coarse mesh's boundary.
+
+        Nested overlaps: the patch's outer facets (the integration mesh is the patch mesh).
+        Intersection meshes give every cell its own nodes, so each of their facets is a
+        "boundary" facet: those on the coarse boundary are the pieces of the patch's outer
+        facets, i.e. the facets whose vertices all lie on an outer facet (within 1e-9 of the
+        facet's size).
+        """
         imesh = self.overlap.integration_mesh
+        if self.overlap.method == "nested":
+            return self.outer_facets
         bf = imesh.boundary_facets()
-        mid = imesh.p[:, imesh.facets[:, bf]].mean(axis=1)
-        return bf[self.on_coarse_boundary(mid)]
+        if self.outer_facets.size == 0:
+            return bf[:0]
+        outer = facet_coordinates(self.fine_model.mesh, self.outer_facets)
+        verts = imesh.facets[:, bf]  # (n_v, n_f)
+        x = imesh.p[:, verts]  # (dim, n_v, n_f)
+        size = np.max(np.linalg.norm(x - x[:, :1], axis=0), axis=0)  # (n_f,)
+        if imesh.dim() == 1:
+            size = cell_sizes(self.fine_model.mesh).min() * np.ones(bf.size)
+        d = distance_to_facets(x.reshape(imesh.dim(), -1), outer).reshape(verts.shape)
+        return bf[np.all(d <= 1e-9 * size[None, :], axis=0)]

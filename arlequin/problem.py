@@ -171,8 +171,30 @@ class ArlequinProblem:
         """Body force density (N/m³), split between the models by the partition weights.
 
         ``force`` is a constant vector or a callable of x (dim, n_elems, n_qp).
+
+        Raises
+        ------
+        ValueError
+            For a constant force with the wrong number of components or a non-finite value.
         """
+        self._check_vector(force, "body force (N/m^3)")
+        self._check_blocks(blocks)
         self._loads.append(_Load("body", force, None, amplitude, blocks))
+
+    def _check_vector(self, value: Any, what: str) -> None:
+        if callable(value):
+            return
+        vec = np.asarray(value, dtype=float).ravel()
+        d = int(self.coarse.n_components)
+        if vec.size != d:
+            raise ValueError(f"{what} must have {d} components, got {vec.tolist()}")
+        if not np.all(np.isfinite(vec)):
+            raise ValueError(f"{what} must be finite, got {vec.tolist()}")
+
+    def _check_blocks(self, blocks: Sequence[str] | None) -> None:
+        for b in blocks or ():
+            if b not in self._names:
+                raise ValueError(f"unknown block {b!r}; blocks are {self._names}")
 
     def add_traction(
         self,
@@ -186,7 +208,24 @@ class ArlequinProblem:
         Applied on the boundary facets (of the coarse mesh and of each patch mesh, on the coarse
         boundary) whose midpoints satisfy ``where`` (default: the whole boundary). ``traction``
         is a constant vector or a callable of (x, n) returning (dim, n_facets, n_qp).
+
+        Raises
+        ------
+        ValueError
+            For a constant traction with the wrong number of components or a non-finite value,
+            or a selector ``where`` that matches no boundary facet of the coarse mesh nor of
+            any patch (an interior line, a typo in a coordinate).
         """
+        self._check_vector(traction, "traction (Pa)")
+        self._check_blocks(blocks)
+        if where is not None:
+            meshes = [self.coarse.mesh] + [p.model.mesh for p in self.patches]
+            if not any(self._facets(m, where).size for m in meshes):
+                raise ValueError(
+                    "the traction selector `where` matches no boundary facet of the coarse mesh "
+                    "or of any patch (it is evaluated at facet midpoints, shape (dim, n)): "
+                    "tractions act on the physical boundary only"
+                )
         self._loads.append(_Load("traction", traction, where, amplitude, blocks))
 
     # ------------------------------------------------------------------ assembly

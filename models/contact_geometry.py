@@ -20,7 +20,7 @@ import scipy.sparse as sp
 from skfem import Mesh
 
 from arlequin.dofs import node_dofs
-from arlequin.geometry import cyclic_quad_faces
+from arlequin.geometry import cyclic_quad_faces, facet_normals
 
 from .obstacles import Obstacle
 
@@ -105,7 +105,7 @@ class ContactSurface:
         # outward orientation sign of the facet normal computed from the node order
         elem = mesh.f2t[0, facets]
         centroid = mesh.p[:, mesh.t[:, elem]].mean(axis=1)  # (dim, n_f)
-        n_ref, _ = _facet_normals(_facet_points(mesh.p, fn))
+        n_ref, _ = facet_normals(_facet_points(mesh.p, fn))
         fmid = _facet_points(mesh.p, fn).mean(axis=2)  # (dim, n_f)
         s = np.sign(np.sum(n_ref * (fmid - centroid), axis=0))
         s[s == 0.0] = 1.0
@@ -143,30 +143,8 @@ def _facet_points(p: np.ndarray, fn: np.ndarray) -> np.ndarray:
     return p[:, fn]
 
 
-def _facet_normals(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Unit normals (from the vertex order) and measures of facets x (dim, n_f, n_v)."""
-    dim, nf, nv = x.shape
-    if dim == 1:
-        return np.ones((1, nf)), np.ones(nf)
-    if dim == 2:
-        t = x[:, :, 1] - x[:, :, 0]
-        n = np.stack([t[1], -t[0]])
-        ln = np.linalg.norm(n, axis=0)
-        return n / ln, ln
-    if nv == 3:
-        n = np.cross(x[:, :, 1] - x[:, :, 0], x[:, :, 2] - x[:, :, 0], axis=0)
-        ln = np.linalg.norm(n, axis=0)
-        return n / ln, 0.5 * ln
-    # quadrilateral: mean normal of the two diagonals' cross product; area of its two triangles
-    n = 0.5 * np.cross(x[:, :, 2] - x[:, :, 0], x[:, :, 3] - x[:, :, 1], axis=0)
-    e1, e2, e3 = (x[:, :, i] - x[:, :, 0] for i in (1, 2, 3))
-    a1 = 0.5 * np.linalg.norm(np.cross(e1, e2, axis=0), axis=0)
-    a2 = 0.5 * np.linalg.norm(np.cross(e2, e3, axis=0), axis=0)
-    return n / np.linalg.norm(n, axis=0), a1 + a2
-
-
 def _facet_measure(x: np.ndarray) -> np.ndarray:
-    return _facet_normals(x)[1]
+    return facet_normals(x)[1]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -307,7 +285,7 @@ class DeformableContactPair(ContactPair):
             bary, dist = _closest_on_triangles(xs, xf)
             k = np.argmin(dist, axis=1)
             shape = bary[np.arange(xs.shape[1]), k]
-        nrm, _ = _facet_normals(xf[:, k])
+        nrm, _ = facet_normals(xf[:, k])
         nrm = nrm * self._orient[k]
         xm = np.einsum("dkv,kv->dk", xf[:, k], shape)
         return k, shape, xm, nrm

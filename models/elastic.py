@@ -29,6 +29,7 @@ import scipy.sparse as sp
 from skfem import Basis, BilinearForm, ElementVector, FacetBasis, LinearForm, Mesh
 from skfem.helpers import dot, grad
 
+from arlequin.meshcheck import check_mesh
 from arlequin.reference import scalar_element_for
 
 __all__ = [
@@ -61,6 +62,10 @@ class IsotropicElastic:
     density: float = 1.0
 
     def __post_init__(self) -> None:
+        for name in ("young", "poisson", "density"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.number)):
+                raise ValueError(f"{name} must be a number (SI units), got {value!r}")
         if not np.isfinite(self.young) or self.young <= 0.0:
             raise ValueError(f"Young's modulus must be positive and finite, got young={self.young}")
         if not -1.0 < self.poisson < 0.5:
@@ -105,6 +110,12 @@ class LinearElastic:
     intorder : int, optional
         Quadrature order (polynomial degree integrated exactly). Default 3 (4 for hexahedra):
         exact for a first-order weight times the stiffness of a linear field on P1/Q1 cells.
+    validate : bool
+        Check the mesh (:func:`arlequin.meshcheck.check_mesh`: non-finite or unused nodes,
+        degenerate and folded cells, coincident nodes) and raise ``MeshError`` naming the node
+        or cell.
+    allow_seams : bool
+        Accept coincident nodes (a crack meant to be open).
 
     Notes
     -----
@@ -122,6 +133,9 @@ class LinearElastic:
         kind: str | None = None,
         area: float = 1.0,
         intorder: int | None = None,
+        *,
+        validate: bool = True,
+        allow_seams: bool = False,
     ) -> None:
         if not isinstance(mesh, Mesh):
             raise ValueError(f"mesh must be a scikit-fem Mesh, got {type(mesh).__name__}")
@@ -143,6 +157,8 @@ class LinearElastic:
             )
         if area <= 0.0:
             raise ValueError(f"cross-section area must be positive, got area={area}")
+        if validate:
+            check_mesh(mesh, f"the {type(mesh).__name__} of the model", allow_seams)
         if kind == "axisymmetric" and np.min(mesh.p[0]) < -1e-12 * np.ptp(mesh.p[0]):
             raise ValueError(
                 f"axisymmetric mesh must have r = x[0] >= 0, got min r = {np.min(mesh.p[0])}"
@@ -166,7 +182,11 @@ class LinearElastic:
     # ------------------------------------------------------------------ construction helpers
     def with_mesh(self, mesh: Mesh) -> LinearElastic:
         """Same material and kinematics on another mesh (used for overlap integration)."""
-        return LinearElastic(mesh, self.material, self.kind, self.area, self.intorder)
+        # integration meshes of overlaps are built by the core (intersection meshes give each
+        # cell its own nodes on purpose): not validated again
+        return LinearElastic(
+            mesh, self.material, self.kind, self.area, self.intorder, validate=False
+        )
 
     @property
     def n_dofs(self) -> int:

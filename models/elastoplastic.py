@@ -81,8 +81,12 @@ class J2Material:
     hardening_modulus: float = 0.0
 
     def __post_init__(self) -> None:
-        # reuse the elastic checks (E > 0, ν in (-1, 0.5), ρ ≥ 0)
+        # reuse the elastic checks (numbers, E > 0, ν in (-1, 0.5), ρ ≥ 0)
         IsotropicElastic(self.young, self.poisson, self.density)
+        for name in ("yield_stress", "hardening_modulus"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.number)):
+                raise ValueError(f"{name} must be a number (Pa), got {value!r}")
         if not np.isfinite(self.yield_stress) or self.yield_stress <= 0.0:
             raise ValueError(f"yield stress must be positive, got yield_stress={self.yield_stress}")
         if not np.isfinite(self.hardening_modulus) or self.hardening_modulus < 0.0:
@@ -268,8 +272,9 @@ class FiniteStrainJ2:
     is_linear = False
 
     def __init__(
-        self, mesh: Mesh, material: J2Material, kind: str | None = None, fbar: bool = True
-    ) -> None:
+        self, mesh: Mesh, material: J2Material, kind: str | None = None, fbar: bool = True, *,
+        validate: bool = True, allow_seams: bool = False,
+    ) -> None:  # fmt: skip
         if not isinstance(mesh, MeshQuad | MeshHex):
             raise ValueError(
                 f"FiniteStrainJ2 needs a MeshQuad (axisymmetric, plane strain) or a MeshHex (3d) "
@@ -287,7 +292,8 @@ class FiniteStrainJ2:
         self.dim = dim
         self.intorder = 3
         # checks r >= 0 in axisymmetry; gives the mass, the small-strain stiffness and the bases
-        self.elastic = LinearElastic(mesh, material.elastic, kind=kind, intorder=self.intorder)
+        checks = {"validate": validate, "allow_seams": allow_seams}
+        self.elastic = LinearElastic(mesh, material.elastic, kind, intorder=self.intorder, **checks)
         self.basis = self.elastic.basis
         sb = self.elastic.scalar_basis()
         self._t = np.asarray(mesh.t)  # (n_nodes_per_cell, n_elems)
@@ -319,7 +325,7 @@ class FiniteStrainJ2:
 
     def with_mesh(self, mesh: Mesh) -> FiniteStrainJ2:
         """Same material, kinematics and F-bar choice on another mesh."""
-        return FiniteStrainJ2(mesh, self.material, self.kind, self.fbar)
+        return FiniteStrainJ2(mesh, self.material, self.kind, self.fbar, validate=False)
 
     def nodal_dofs(self) -> np.ndarray:
         """Dof indices per node, shape (dim, n_nodes)."""

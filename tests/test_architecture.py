@@ -23,7 +23,13 @@ ROOT = Path(arlequin.__file__).resolve().parent  # arlequin/
 MODELS = ROOT.parent / "models"
 
 #: What models may import from the core (besides themselves): the contract and pure helpers.
-MODEL_ALLOWED = {"arlequin.contract", "arlequin.dofs", "arlequin.reference", "arlequin.geometry"}
+MODEL_ALLOWED = {
+    "arlequin.contract",
+    "arlequin.dofs",
+    "arlequin.reference",
+    "arlequin.geometry",
+    "arlequin.meshcheck",
+}
 
 
 def module_name(path: Path) -> str:

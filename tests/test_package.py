@@ -69,3 +69,25 @@ def test_console_script_entry_point():
     )
     assert r.returncode == 0, r.stderr
     assert "max_error" in r.stdout
+
+
+def test_models_import_from_the_repository_root_without_the_installed_mapping():
+    """From the source tree (as after ``pip install .`` run in the repository root, where the
+    local ``arlequin/`` shadows the installed package), ``arlequin.models`` is the sibling
+    ``models/`` folder. Simulated here by dropping the editable install's finders."""
+    root = ROOT.parent
+    code = (
+        "import sys\n"
+        "sys.meta_path = [f for f in sys.meta_path if 'ditable' not in "
+        "getattr(f, '__name__', type(f).__name__) and 'ditable' not in "
+        "getattr(f, '__module__', '')]\n"
+        f"sys.path.insert(0, {str(root)!r})\n"
+        "import arlequin.models, arlequin.models.contact\n"
+        "print(arlequin.__file__)\n"
+        "print(arlequin.models.__file__)\n"
+    )
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=False)
+    assert r.returncode == 0, r.stderr
+    pkg, models = r.stdout.split()
+    assert Path(pkg) == root / "arlequin" / "__init__.py"
+    assert Path(models) == root / "models" / "__init__.py"

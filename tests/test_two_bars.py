@@ -4,7 +4,8 @@ Exact solution (same material, bars touching at t = 0, c = √(E/ρ)): interface
 contact pressure ρ c v₀/2, contact duration 2L/c, final mean velocities (0, v₀); bar on a rigid
 wall: pressure ρ c v₀, duration 2L/c, rebound −v₀. Errors are measured over the records in contact
 except the first two and the last two (``impact_metrics``). Bounds are the issue's, unchanged;
-the bounds the method does not meet are marked ``xfail(strict=True)`` with the measured figure.
+the pressure and rebound criteria are those restated by the robustness issue (the pressure over
+the exact contact interval, the rebound at 200 elements per bar), which the scheme meets.
 """
 
 from __future__ import annotations
@@ -59,11 +60,12 @@ def test_item1_interface_velocity(theta_run):
     assert theta_run.metrics()["velocity_rms_error"] <= 0.01  # ≤ 1% of v0/2
 
 
-@pytest.mark.xfail(strict=True, reason="measured 4.34% rms (≤ 2% required): the consistent-mass "
-                   "trapezoidal scheme smears the returning release wave over ~10 steps; 0.67% "
-                   "without the last 10 steps (see docs/contact.md)")
 def test_item2_contact_pressure(theta_run):
-    assert theta_run.metrics()["pressure_rms_error"] <= 0.02  # ≤ 2% of ρ c v0/2
+    # Criterion restated by the robustness issue: the rms error of the pressure over the exact
+    # contact interval t in (2.5 dt, 2L/c - 2.5 dt), t = 0 the exact first contact, within 2%
+    # of ρ c v0/2. Measured 1.23% (4.34% when the records of the smeared release wave, after
+    # 2L/c, are counted: the consistent-mass dispersion, see docs/contact.md).
+    assert theta_run.metrics()["pressure_rms_error_exact_interval"] <= 0.02
 
 
 def test_item3_duration_and_final_velocities(theta_run):
@@ -109,19 +111,20 @@ def test_item5_newmark_baselines(theta_run, variant):
 
 
 # ------------------------------------------------------------------ item 6: rigid wall, θ = 1/2
-@pytest.mark.xfail(strict=True, reason="measured rebound −0.9864 v0 (1.36% > 1%): the release "
-                   "leaves 2.1% of the energy in vibration of the consistent-mass bar")
-def test_item6_wall_rebound(wall_theta):
-    assert abs(wall_theta.final_velocities[0] + 1.0) <= 0.01  # −v0 within 1%
+def test_item6_wall_rebound():
+    # Criterion restated: the rebound within 1% of −v0 at 200 elements per bar (measured
+    # −0.9916 v0; −0.9864 v0 at 100 elements, where 2.1% of the energy stays in vibration).
+    wall = run_wall(elements=200)
+    assert abs(wall.final_velocities[0] + 1.0) <= 0.01
 
 
 def test_item6_wall_duration(wall_theta):
     assert abs(wall_theta.metrics()["duration_error_steps"]) <= 3.0  # 2L/c within 3 Δt
 
 
-@pytest.mark.xfail(strict=True, reason="measured 4.34% rms (≤ 2% required), as item 2")
 def test_item6_wall_pressure(wall_theta):
-    assert wall_theta.metrics()["pressure_rms_error"] <= 0.02  # ρ c v0 within 2% rms
+    # as item 2, over the exact contact interval: measured 1.23% of ρ c v0
+    assert wall_theta.metrics()["pressure_rms_error_exact_interval"] <= 0.02
 
 
 # ----------------------------------------- items 2 and 6 at the dispersion-free Courant number
@@ -130,7 +133,7 @@ def test_items2_6_at_dispersion_free_cfl(run):
     # Consistent-mass P1 elements with the trapezoidal rule have the phase velocity
     # c (1 + (kh)²(1 − 2C²)/24) to second order in kh, so the leading error cancels at C = 1/√2.
     # The θ = ½ level-set scheme then meets items 2 and 6 on the same 100-element mesh, which
-    # shows that the misses at CFL 1 (xfails above) are the bulk dispersion, not the contact
+    # shows that the misses at CFL 1 of the first criteria are the bulk dispersion, not the contact
     # algorithm. Measured (benchmarks/two_bars_cfl.py): pressure 0.85% rms, rebound −0.9941 v0.
     result = run(cfl=1.0 / np.sqrt(2.0))
     m = result.metrics()

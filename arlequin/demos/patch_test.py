@@ -66,14 +66,6 @@ class PatchTestResult(JsonResult):
         )
 
 
-def exactness_expected(dim: str, weights: str, mediator: str, mesh: str) -> bool:
-    """Whether the configuration satisfies the exactness conditions of ``docs/theory.md``."""
-    if weights == "ramp":
-        return True
-    # constant weights: exact only for a nested patch with the fine mediator
-    return mesh == "nested" and mediator == "fine"
-
-
 def _spacing(n: int, length: float, rng: np.random.Generator) -> np.ndarray:
     """Random positive spacings, each within [0.6, 1.4] x the mean (so >= 1/3 of it)."""
     h = rng.uniform(0.6, 1.4, n)
@@ -199,6 +191,37 @@ def _build_3d(rng, mesh_kind):
     return coarse, fine, w
 
 
+#: Patch layouts of :func:`run_patch_test`.
+LAYOUTS = ("random", "strip", "square")
+
+
+def _build_grid_patch(layout: str, mesh_kind: str, ratio: int, band_cells: int):
+    """Uniform 2D grids (coarse cell h = 0.25 m): a strip spanning the domain from bottom to
+    top (it touches the coarse boundary), or a square inside it; the fine mesh has ``ratio``
+    cells per coarse cell edge (nested quadrilaterals, or non-nested triangles)."""
+    h = 0.25
+    if layout == "strip":
+        nx, ny = 4 + 2 * band_cells + 4, 4
+        i0, i1, j0, j1 = 2, nx - 2, 0, ny
+    else:
+        n_patch = 2 * band_cells + 2
+        nx = ny = n_patch + 4
+        i0, i1, j0, j1 = 2, 2 + n_patch, 2, 2 + n_patch
+    xc, yc = np.arange(nx + 1) * h, np.arange(ny + 1) * h
+    xf = np.linspace(xc[i0], xc[i1], (i1 - i0) * ratio + 1)
+    yf = np.linspace(yc[j0], yc[j1], (j1 - j0) * ratio + 1)
+    if mesh_kind == "nested":
+        coarse, fine = skfem.MeshQuad.init_tensor(xc, yc), skfem.MeshQuad.init_tensor(xf, yf)
+    else:
+        coarse, fine = skfem.MeshTri.init_tensor(xc, yc), skfem.MeshTri.init_tensor(xf, yf)
+        # mirrored about the patch's mid-line: the same nodes, the other diagonals, so that
+        # the fine triangles do not refine the coarse ones (an intersection overlap)
+        p = fine.p.copy()
+        p[0] = xc[i0] + xc[i1] - p[0]
+        fine = skfem.MeshTri(p, fine.t)
+    return coarse, fine, band_cells * h
+
+
 def build_patch_test_problem(
     dim: str | int = "2",
     coupling: str = "H1",
@@ -206,8 +229,11 @@ def build_patch_test_problem(
     mediator: str = "coarse",
     mesh: str = "nested",
     seed: int = 0,
+    layout: str = "random",
+    ratio: int = 4,
+    band_cells: int = 1,
 ):
-    """Build the random patch-test problem (see :func:`run_patch_test`).
+    """Build the patch-test problem (see :func:`run_patch_test`).
 
     Returns
     -------
@@ -223,9 +249,21 @@ def build_patch_test_problem(
         raise ValueError(f"dim must be one of {DIMS}, got {dim!r}")
     if mesh not in ("nested", "nonnested"):
         raise ValueError(f"mesh must be 'nested' or 'nonnested', got {mesh!r}")
+    if layout not in LAYOUTS:
+        raise ValueError(f"layout must be one of {LAYOUTS}, got {layout!r}")
+    if isinstance(seed, bool) or int(seed) != seed or seed < 0:
+        raise ValueError(f"seed must be a non-negative integer, got seed={seed}")
     rng = np.random.default_rng(seed)
     axi = dim == "axi"
-    if dim == "1":
+    if layout != "random":
+        if dim != "2":
+            raise ValueError(f"layout={layout!r} is a 2D plane-strain layout, got dim={dim!r}")
+        if isinstance(ratio, bool) or int(ratio) != ratio or ratio < 1:
+            raise ValueError(f"ratio must be a positive integer, got ratio={ratio}")
+        if isinstance(band_cells, bool) or int(band_cells) != band_cells or band_cells < 1:
+            raise ValueError(f"band_cells must be a positive integer, got band_cells={band_cells}")
+        coarse_mesh, fine_mesh, w = _build_grid_patch(layout, mesh, int(ratio), int(band_cells))
+    elif dim == "1":
         coarse_mesh, fine_mesh, w = _build_1d(rng, mesh)
     elif dim == "3":
         coarse_mesh, fine_mesh, w = _build_3d(rng, mesh)
@@ -261,6 +299,9 @@ def run_patch_test(
     mesh: str = "nested",
     seed: int = 0,
     out: str | Path | None = None,
+    layout: str = "random",
+    ratio: int = 4,
+    band_cells: int = 1,
 ) -> PatchTestResult:
     """Run one random patch test; see the module docstring.
 
@@ -272,15 +313,29 @@ def run_patch_test(
     mediator : {"coarse", "fine"}
     mesh : {"nested", "nonnested"}
     seed : int
+        Seed of the random layout (≥ 0).
     out : path, optional
         Results folder to write (:class:`arlequin.io.ResultsFolder`): results.json,
         history.csv (the strain energies and the residual) and one frame per model (the
         displacement, the weight alpha, the multiplier field).
+    layout : {"random", "strip", "square"}
+        ``"random"``: the random configuration above; ``"strip"``: a uniform 2D grid with a
+        patch spanning it from bottom to top (touching the coarse boundary), glued at its two
+        ends; ``"square"``: a square patch inside the grid, glued all around (its band turns
+        corners: not an exact configuration with the coarse mediator). 2D only.
+    ratio : int
+        Coarse/fine cell size ratio of the strip and square layouts.
+    band_cells : int
+        Gluing band width in coarse cells (strip and square layouts).
     """
     inputs = {"dim": str(dim), "coupling": coupling, "weights": weights, "mediator": mediator,
-              "mesh": mesh, "seed": seed}  # fmt: skip
-    folder = ResultsFolder(out, "arlequin patch-test", inputs) if out is not None else None
-    problem, exact = build_patch_test_problem(dim, coupling, weights, mediator, mesh, seed)
+              "mesh": mesh, "seed": seed, "layout": layout, "ratio": ratio,
+              "band_cells": band_cells}  # fmt: skip
+    problem, exact = build_patch_test_problem(
+        dim, coupling, weights, mediator, mesh, seed, layout, ratio, band_cells
+    )
+    units = {"seed": "1", "ratio": "1", "band_cells": "coarse cells"}
+    folder = ResultsFolder(out, "arlequin patch-test", inputs, units) if out is not None else None
     dim = str(dim)
     coarse_mesh = problem.coarse.mesh
     fine_mesh = problem.patches[0].model.mesh
@@ -291,7 +346,8 @@ def run_patch_test(
     max_error = max(np.abs(result.displacements[k] - v).max() for k, v in u_exact.items()) / scale
     sp_sys = result.saddle_point
     u_full = np.concatenate([u_exact["coarse"], u_exact[name]])
-    lam = sp_sys.best_multipliers(u_full)
+    solved = np.concatenate([result.multipliers[k] for k in sp_sys.multiplier_slices])
+    lam = sp_sys.best_multipliers(u_full, initial=solved)
     residual = sp_sys.residual(u_full, lam)
     pc = problem.couplings[0]
     out_result = PatchTestResult(
@@ -307,7 +363,7 @@ def run_patch_test(
         mesh=mesh,
         seed=int(seed),
         overlap_method=pc.overlap.method,
-        exact_expected=exactness_expected(dim, weights, mediator, mesh),
+        exact_expected=not pc.exactness_failures,
     )
     out_result.static = result
     if folder is not None:

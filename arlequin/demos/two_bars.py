@@ -241,13 +241,9 @@ def run_two_bars(
     """
     if method not in ("levelset", "newmark", "both"):
         raise ValueError(f"method must be 'levelset', 'newmark' or 'both', got {method!r}")
+    _check_common(young, density, cfl, elements, t_end, theta, velocity=velocity,
+                  velocity2=velocity2, length1=lengths[0], length2=lengths[1])  # fmt: skip
     l1, l2 = (float(x) for x in lengths)
-    if not (l1 > 0 and l2 > 0):
-        raise ValueError(f"bar lengths must be positive, got lengths={lengths}")
-    if int(elements) < 1:
-        raise ValueError(f"elements must be >= 1, got {elements}")
-    if not cfl > 0:
-        raise ValueError(f"cfl must be positive, got cfl={cfl}")
     if not velocity > velocity2:
         raise ValueError(f"bar 1 must approach bar 2: velocity={velocity} <= velocity2={velocity2}")
     material = IsotropicElastic(young, 0.3, density)
@@ -333,6 +329,7 @@ def run_wall(
     """
     if method not in ("levelset", "newmark"):
         raise ValueError(f"method must be 'levelset' or 'newmark', got {method!r}")
+    _check_common(young, density, cfl, elements, t_end, theta, velocity=velocity, length=length)
     if not velocity > 0:
         raise ValueError(f"the bar must approach the wall: velocity={velocity}")
     material = IsotropicElastic(young, 0.3, density)
@@ -388,6 +385,28 @@ _RESULT_UNITS = {"velocity_rms_error": "1", "pressure_rms_error": "1", "duration
                  "final_velocity_error": "1", "energy_loss": "1", "max_energy_gain": "1",
                  "contact_work": "J", "balance_error": "1", "contact_duration": "s", "dt": "s",
                  "final_velocities": "m/s"}  # fmt: skip
+
+
+def _check_common(young, density, cfl, elements, t_end, theta, **finite) -> None:
+    """Refuse, before any work, the inputs that would end in a division by zero, a NaN or a
+    meaningless run, naming the quantity and its value."""
+    for name, value in {"young": young, "density": density, "cfl": cfl, **finite}.items():
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.number)):
+            raise ValueError(f"{name} must be a number, got {value!r}")
+        if not math.isfinite(value):
+            raise ValueError(f"{name} must be finite, got {name}={value}")
+    for name, value in {"young": young, "density": density, "cfl": cfl}.items():
+        if not value > 0.0:
+            raise ValueError(f"{name} must be positive, got {name}={value}")
+    for name in ("length", "length1", "length2"):
+        if name in finite and not finite[name] > 0.0:
+            raise ValueError(f"bar lengths must be positive, got {name}={finite[name]}")
+    if isinstance(elements, bool) or int(elements) != elements or elements < 1:
+        raise ValueError(f"elements must be a positive integer, got elements={elements}")
+    if t_end is not None and not (math.isfinite(t_end) and t_end > 0.0):
+        raise ValueError(f"t_end must be positive and finite (s), got t_end={t_end}")
+    if not 0.5 <= theta <= 1.0:
+        raise ValueError(f"theta must lie in [1/2, 1], got theta={theta}")
 
 
 def _folder(out, command: str, config: dict[str, Any]) -> ResultsFolder | None:

@@ -44,6 +44,7 @@ from ..integrators import (
     solve,
     stable_time_step,
 )
+from ..integrators.controllers import check_step
 from ..io import DynamicRunWriter, JsonResult, ResultsFolder
 from ..models import IsotropicElastic, LinearElastic
 from ..problem import ArlequinProblem, Patch
@@ -204,6 +205,12 @@ def run_wave(
         )
     name = INTEGRATORS.get(integrator, integrator)
     cls = get_integrator(name)
+    if dt is not None:
+        dt = check_step(dt, "time step dt (s)")
+    for what, value in (("pulse_width", pulse_width), ("gluing_width", gluing_width),
+                        ("epsilon", epsilon)):  # fmt: skip
+        if not math.isfinite(float(value)):
+            raise ValueError(f"{what} must be finite, got {what}={value}")
     inputs = {"ratio": ratio, "pulse_width": pulse_width, "gluing_width": gluing_width,
               "coupling": coupling, "mediator": mediator, "weights": weights,
               "integrator": integrator, "dt": dt, "epsilon": epsilon, "length": length}  # fmt: skip
@@ -239,8 +246,8 @@ def run_wave(
     stable = stable_time_step(system)
     if dt is None:
         dt = DEFAULT_SAFETY * stable.critical
-    else:
-        check_time_step(dt, stable)
+    elif issubclass(cls, CentralDifference):
+        check_time_step(dt, stable)  # implicit schemes are unconditionally stable here
     t_m = lay["travel"] * H / c
     n_steps = math.ceil(t_m / dt)
     lumped = bool(cls.lumped_default)

@@ -362,17 +362,24 @@ class CentralDifference(Integrator):
         for c, lam in zip(self.unilateral, fulls):
             mult[c.name] = lam
         self.multipliers = mult
-        self._p_now = self._powers()
-        # works of the step that ended at t (trapezoidal on the powers at both ends): pending
-        # until the next step starts, since a new step size at t changes the powers at t
+        # works of the step that ended at t: the trapezoidal rule on the forces at both ends
+        # times the step's own (mid-step) velocity v^{n-1/2}, the discrete work that closes the
+        # balance of the scheme's energy exactly for linear systems. Pending until the next
+        # step starts, since a new step size at t changes the forces at t.
         half = 0.5 * dt_prev
-        (pe, pc, po), (qe, qc, qo) = self._p_prev, self._p_now
+        (pe, pc, po), (qe, qc, qo) = self._p_prev, self._powers(v_minus)
         self._w_pending = (half * (pe + qe), half * (pc + qc), half * (po + qo))
 
-    def _powers(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """External, coupling and other-constraint powers per block at the current time (W)."""
+    def _kinetic(self) -> np.ndarray:
+        """The scheme's kinetic energy per block (J): ½ ṽ^{n−½}·M v^{n+½}, with ṽ^{n−½} the
+        mid-step velocity the step Δt_n would have before t_n (v^{n−½} for a constant step)."""
+        back = self._v_next - (self.dt / self._dt_bar) * (self._v_next - self._v_minus)
+        return 0.5 * self.ops.block_dots(back, self.ops.mass * self._v_next)
+
+    def _powers(self, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """External, coupling and other-constraint powers per block (W) of the forces at the
+        current time with the velocity v (m/s)."""
         nb = len(self.ops.blocks)
-        v = self.v
         p_ext = self.ops.block_dots(self._f_ext, v) if self._f_ext is not None else np.zeros(nb)
         if self.rows.m:
             lam = self._lam_e / self._dt_bar
@@ -422,7 +429,7 @@ class CentralDifference(Integrator):
     def _scheme_fields(self) -> tuple[str, ...]:
         return (
             "_v_next", "_v_minus", "_dt_prev", "_dt_bar", "_f_int", "_f_ext", "_lam_e", "_lam_a",
-            "_g_a", "_p_now", "_p_prev", "_w_pending", "_pre_impulse_states", "_critical_now",
+            "_g_a", "_p_prev", "_w_pending", "_pre_impulse_states", "_critical_now",
             "_critical_at", "_impulse_failed",
         )  # fmt: skip
 
@@ -436,7 +443,7 @@ class CentralDifference(Integrator):
         a_new = self._acceleration(f_int, f_ext)
         # the step size at t is final now: commit the works of the step that ended at t
         self._w_ext, self._w_coupling, self._w_constraint = self._works()
-        self._p_prev = self._p_now
+        self._p_prev = self._powers(v_half)  # the forces at t with this step's velocity
         # commit the step's kinematics and model states
         if not self.ops.linear:
             self._w_internal += self.ops.block_dots(u_new - self.u, 0.5 * (self._f_int + f_int))

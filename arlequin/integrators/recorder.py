@@ -84,6 +84,7 @@ class Recorder:
         return DynamicResult(
             times=np.array(self.times),
             kinetic=hist("kinetic"),
+            kinetic_full_step=hist("kinetic_full_step"),
             strain=hist("strain"),
             external_work=hist("external_work"),
             coupling_work=hist("coupling_work"),

@@ -36,7 +36,9 @@ class DynamicResult:
     times : ndarray, shape (n_rec,)
         Recorded times (s), starting with the initial time.
     kinetic, strain : dict
-        Block name -> α-weighted kinetic / strain energy (J), shape (n_rec,).
+        Block name -> α-weighted kinetic / strain energy (J), shape (n_rec,). ``kinetic`` is the
+        integrator's energy form (central differences: ½ ṽ^{n−½}·M v^{n+½}; see
+        docs/dynamics.md), the one the balance is written with.
     external_work, coupling_work, constraint_work : dict
         Block name -> accumulated work (J) of the external forces, of the coupling (mediator)
         forces and of the other constraint forces (Dirichlet reactions, contact), shape (n_rec,).
@@ -70,6 +72,9 @@ class DynamicResult:
     constraint_records : dict
         Unilateral constraint name -> the per-step records of the recorded steps (one per record
         after the initial one, i.e. aligned with ``times[1:]``); see :meth:`history`.
+    kinetic_full_step : dict
+        Block name -> ½ vᵀM v of the full-step velocity (J), shape (n_rec,): a diagnostic (for
+        the explicit scheme it differs from ``kinetic`` by O((ωΔt)²) of the excited modes).
     """
 
     times: np.ndarray
@@ -94,6 +99,7 @@ class DynamicResult:
     step_sizes: np.ndarray | None = None
     constraint_states: dict[str, Any] = field(default_factory=dict, repr=False)
     constraint_records: dict[str, list[Any]] = field(default_factory=dict, repr=False)
+    kinetic_full_step: dict[str, np.ndarray] = field(default_factory=dict)
 
     @property
     def success(self) -> bool:
