@@ -133,8 +133,10 @@ class DynamicModel(Protocol):
 
     Notes
     -----
-    Optional members: ``n_components`` (default 1) and ``initial_state(weight)`` (default None:
-    the first ``internal_force`` call gets ``state=None``).
+    Optional members: ``n_components`` (default 1), ``initial_state(weight)`` (default None:
+    the first ``internal_force`` call gets ``state=None``) and ``uses_time_step`` (default
+    False): when True, the integrators call ``internal_force(u, state, weight, dt=h)`` with h
+    (s) the step that leads to u (None at the initial time), for rate-dependent state updates.
     """
 
     n_dofs: int

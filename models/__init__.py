@@ -5,7 +5,9 @@ evaluated at quadrature points (the energy partition weight α, default 1). They
 against :mod:`arlequin.contract` (the protocols and shared errors), the only part of the core
 they import besides its pure helpers (dof layout, reference elements, facet geometry).
 
-Modules: ``elastic`` (small-strain linear elasticity), ``elastoplastic`` (finite-strain J2),
+Modules: ``elastic`` (small-strain linear elasticity), ``hardening`` (isotropic hardening
+laws), ``j2`` (the J2 material point), ``kinematics`` (finite-strain Q1 kinematics, F-bar),
+``j2_kernel`` (the compiled planar kernel), ``elastoplastic`` (finite-strain J2 model),
 ``obstacles`` (rigid level-set obstacles), ``contact_geometry`` (contact surfaces and pairs),
 ``contact`` (the level-set Signorini–Moreau contact model and the Signorini baseline).
 """
@@ -33,17 +35,34 @@ from .elastic import (
     element_critical_step,
     scalar_element_for,
 )
-from .elastoplastic import (
-    FiniteStrainJ2,
+from .elastoplastic import BACKENDS, BulkViscosity, FiniteStrainJ2
+from .hardening import (
+    HARDENING_LAWS,
+    CallableHardening,
+    Hardening,
+    JohnsonCookHardening,
+    LinearHardening,
+    VoceHardening,
+    make_hardening,
+)
+from .j2 import (
     InvertedElementError,
     J2Material,
     PlasticState,
     hencky_j2_return,
+    hencky_strain,
+    j2_return_map,
+    j2_update,
 )
+from .kinematics import Q1Kinematics
 from .obstacles import LevelSetObstacle, Obstacle, PlaneObstacle, SphereObstacle
 
 __all__ = [
+    "BACKENDS",
+    "HARDENING_LAWS",
     "KINDS",
+    "BulkViscosity",
+    "CallableHardening",
     "ContactConvergenceError",
     "ContactGeometry",
     "ContactHistory",
@@ -53,20 +72,29 @@ __all__ = [
     "ContactSurface",
     "DeformableContactPair",
     "FiniteStrainJ2",
+    "Hardening",
     "InvertedElementError",
     "IsotropicElastic",
     "J2Material",
+    "JohnsonCookHardening",
     "LevelSetContact",
     "LevelSetObstacle",
     "LinearElastic",
+    "LinearHardening",
     "Obstacle",
     "PlaneObstacle",
     "PlasticState",
+    "Q1Kinematics",
     "RigidContactPair",
     "SignoriniContact",
     "SphereObstacle",
+    "VoceHardening",
     "acoustic_impedance",
     "element_critical_step",
     "hencky_j2_return",
+    "hencky_strain",
+    "j2_return_map",
+    "j2_update",
+    "make_hardening",
     "scalar_element_for",
 ]

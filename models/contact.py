@@ -167,6 +167,7 @@ class _ContactConstraint:
         self.on_failure = on_failure
         self.update_geometry = bool(update_geometry)
         self._u0 = np.zeros(pair.n_dofs)
+        self._b_cache: tuple[sp.csr_matrix, sp.csr_matrix] | None = None
         self._geo0 = pair.geometry(self._u0)
 
     # rows
@@ -175,7 +176,12 @@ class _ContactConstraint:
         return self.pair.n_points
 
     def _make_b(self, g: sp.csr_matrix) -> sp.csr_matrix:
-        return sp.csr_matrix(sp.diags(-self.pair.weights) @ g)
+        cached = self._b_cache
+        if cached is not None and cached[0] is g:  # the pair reuses unchanged rows
+            return cached[1]
+        b = sp.csr_matrix(sp.diags(-self.pair.weights) @ g)
+        self._b_cache = (g, b)
+        return b
 
     def matrix(self) -> sp.csr_matrix:
         """Rows B = −W G in the reference configuration, shape (m, n) (m², or m per unit
@@ -202,7 +208,8 @@ class _ContactConstraint:
     def initial_state(self, u: np.ndarray, v: np.ndarray) -> ContactState:
         m = self.pair.n_points
         return ContactState(
-            np.zeros(m, dtype=bool), 0.0, None, np.zeros(m), self.geometry(u), u.copy()
+            np.zeros(m, dtype=bool), 0.0, None, np.zeros(m), self.geometry(u), u.copy(),
+            np.zeros(m),
         )
 
     def _trial(self, state, t, dt, u, v, active) -> ContactTrial:
@@ -251,15 +258,21 @@ class _ContactConstraint:
             logger.warning(msg)
         vsum = v_before + v_after
         work = state.work - 0.5 * float(np.asarray(impulse) @ (trial.matrix @ vsum))
-        geo_end = self.geometry(u)
+        # the explicit scheme commits at the configuration its step started from: reuse it
+        same = trial.u_start is u or np.array_equal(trial.u_start, u)
+        geo_end = trial.geometry if same else self.geometry(u)
         record = ContactRecord(
             t=float(t), iterations=trial.iterations, converged=not trial.changed,
             active=trial.used, s_d=trial.s_d, s_v=trial.s_v, gap=geo_end.gap,
             gap_start=trial.gap_start, vn_start=trial.vn_start, vn=trial.vn, lam=trial.lam,
             work=work, dt=trial.dt,
         )  # fmt: skip
+        total = np.asarray(impulse, dtype=float)
+        if state.impulse is not None:
+            total = state.impulse + total
         return ContactState(
-            trial.used.copy(), work, record, trial.lam.copy(), geo_end, np.array(u, copy=True)
+            trial.used.copy(), work, record, trial.lam.copy(), geo_end, np.array(u, copy=True),
+            total,
         )
 
     def history(self, result: Any) -> ContactHistory:

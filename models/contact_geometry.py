@@ -121,7 +121,14 @@ class ContactSurface:
         nv = fn.shape[1]
         contrib = np.repeat(meas / nv, nv)
         if axisymmetric:
-            contrib = contrib * 2.0 * np.pi * mesh.p[0, fn.ravel()]
+            if self.dim != 2:
+                raise ValueError(
+                    f"axisymmetric surfaces are meridional (2D), got a {self.dim}D mesh"
+                )
+            # ∫ N_a 2πr ds on each segment (exact for r linear): 2πℓ(2r_a + r_b)/6; unlike
+            # 2πr_a ℓ/2 it is positive at a node on the axis, whose row would be void
+            r = mesh.p[0, fn]  # (n_f, 2)
+            contrib = (2.0 * np.pi * meas[:, None] * (2.0 * r + r[:, ::-1]) / 6.0).ravel()
         self.weights = np.bincount(inv, contrib, minlength=nodes.size)
 
     @property
@@ -214,6 +221,7 @@ class RigidContactPair(ContactPair):
         m, d = slave.n_points, slave.dim
         self._r = np.repeat(np.arange(m), d)
         self._c = slave.node_dofs(slave.nodes).T.ravel()
+        self._rows_cache: tuple[np.ndarray, sp.csr_matrix] | None = None
 
     def geometry(self, u: np.ndarray) -> ContactGeometry:
         x = self.slave.positions(u)
@@ -223,8 +231,15 @@ class RigidContactPair(ContactPair):
         if np.any(~(gn > 0.0)):
             raise ValueError("obstacle gradient vanishes at a contact point")
         n = g / gn
-        vals = (-n).T.ravel()
-        rows = sp.csr_matrix((vals, (self._r, self._c)), shape=(self.slave.n_points, self.n_dofs))
+        cached = self._rows_cache
+        if cached is not None and np.array_equal(cached[0], n):
+            rows = cached[1]  # same normals (a plane, a resting contact): same rows
+        else:
+            vals = (-n).T.ravel()
+            rows = sp.csr_matrix(
+                (vals, (self._r, self._c)), shape=(self.slave.n_points, self.n_dofs)
+            )
+            self._rows_cache = (n.copy(), rows)
         return ContactGeometry(rows, -phi, n)
 
 

@@ -109,6 +109,9 @@ class ContactState:
     geometry : ContactGeometry
         Gaps and rows at ``u_geometry`` (reused by the next step when it starts there).
     u_geometry : ndarray, shape (n,)
+    impulse : ndarray, shape (m,) or None
+        Accumulated ∫λ_v dt at each collocation point (Pa·s): the force on the rows over any
+        interval is −Σ w Δimpulse / Δt (N) with the collocation weights w.
     """
 
     active: np.ndarray
@@ -117,6 +120,7 @@ class ContactState:
     multipliers: np.ndarray
     geometry: ContactGeometry
     u_geometry: np.ndarray
+    impulse: np.ndarray | None = None
 
 
 @dataclass(frozen=True)

@@ -1,26 +1,16 @@
 """Finite-strain J2 elastoplasticity (Simo 1992), total Lagrangian, with an optional weight.
 
-Multiplicative split F = F_e F_p, elastic left Cauchy–Green tensor b_e = F_e F_eᵀ, Hencky
-(logarithmic) elastic strain ε_e = ½ ln b_e and the quadratic energy
-ψ = ½ K (tr ε_e)² + G ‖dev ε_e‖², so the Kirchhoff stress is τ = K tr ε_e 1 + 2G dev ε_e.
-Von Mises yield f = ‖dev τ‖ − √(2/3) σ_y(ε̄p) with linear isotropic hardening
-σ_y(ε̄p) = σ_y0 + H ε̄p, and the exponential-map radial return in principal logarithmic strains
-(exact for any step size under proportional loading). The state at each quadrature point is the
-inverse plastic right Cauchy–Green tensor C_p⁻¹ and ε̄p, in an immutable :class:`PlasticState`.
+The model ties three pieces together: the Q1 kinematics with F-bar
+(:mod:`arlequin.models.kinematics`), the J2 material point (:mod:`arlequin.models.j2`: Hencky
+elasticity, exponential-map return, any hardening law of :mod:`arlequin.models.hardening`) and,
+for planar cells (axisymmetric, plane strain), the compiled kernel that fuses them
+(:mod:`arlequin.models.j2_kernel`, ``backend="numba"``, the default there). The numpy path
+(``backend="numpy"``) is the reference the kernel is tested against.
 
-Volumetric locking under isochoric plastic flow is avoided by the F-bar method on bilinear
-quadrilaterals and trilinear hexahedra, F̄ = (J̄/J)^{1/3} F, with the mean dilatation of the cell
-J̄ = v_e / V_e = ∫ J dV₀ / ∫ dV₀ (current over reference volume). In plane strain J̄ equals
-det F at the cell centre (the classical F-bar). Axisymmetric and 3D cells need the volume
-average: with the centre value a uniform stress leaves interior nodal forces on distorted cells
-(the patch test fails), and with J̄ it does not. The consistent internal force
-(reference configuration, weight w₀ = α dV₀) is
-
-    f_a = Σ_qp w₀ [τ ∇ₓN_a + p (div̄N_a − div N_a) e],     p = tr τ / 3,
-
-with ∇ₓN_a = F⁻ᵀ ∇_X N_a, div N_a e_i its i-th component (plus N_a / r for the radial component
-in axisymmetry), and div̄ the cell average of div weighted by J dV₀. Axisymmetric kinematics add
-the hoop stretch F_θθ = r/R = 1 + u_r/R and the hoop term τ_θθ N_a / r.
+Optional artificial bulk viscosity (off by default): on compression a pressure
+q = ρ (c_quad ℓ² ε̇_v² − c_lin ℓ c_d ε̇_v) (ε̇_v = J̄̇/J̄ from the step, ρ = ρ₀/J̄, ℓ the cell size)
+is added to the stress; its work is accumulated in the state (``viscous_work``) like the plastic
+work (``plastic_work``), so that energy balances can count both.
 
 Units: SI (m, kg, s, Pa, N). Quadrature-point arrays have shape (components…, n_elems, n_qp).
 The model knows nothing about Arlequin: ``weight`` (α at quadrature points, default 1) scales
@@ -30,17 +20,27 @@ every integrand.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
-from skfem import Basis, Mesh, MeshHex, MeshQuad
+from skfem import Basis, Mesh
 
 from arlequin.contract import StateError
 
-from .elastic import IsotropicElastic, LinearElastic, WeightLike, element_critical_step
+from .elastic import LinearElastic, WeightLike, element_critical_step
+from .j2 import (
+    InvertedElementError,
+    J2Material,
+    PlasticState,
+    hencky_j2_return,
+    hencky_strain,
+    j2_return_map,
+)
+from .kinematics import KINDS, Q1Kinematics  # noqa: F401  (KINDS re-exported)
 
 __all__ = [
+    "BACKENDS",
+    "BulkViscosity",
     "FiniteStrainJ2",
     "InvertedElementError",
     "J2Material",
@@ -48,200 +48,23 @@ __all__ = [
     "hencky_j2_return",
 ]
 
-KINDS = ("plane_strain", "axisymmetric", "3d")
-SQRT23 = np.sqrt(2.0 / 3.0)
-
-
-class InvertedElementError(StateError):
-    """A cell's Jacobian det F became non-positive (or non-finite) at a quadrature point."""
+#: Backends of the internal force: the compiled kernel (planar cells) and the numpy reference.
+BACKENDS = ("auto", "numba", "numpy")
 
 
 @dataclass(frozen=True)
-class J2Material:
-    """Isotropic elastoplastic material with von Mises yield and linear isotropic hardening.
+class BulkViscosity:
+    """Artificial bulk viscosity (LS-DYNA's defaults): q = ρ (c_quad ℓ² ε̇_v² − c_lin ℓ c_d ε̇_v)
+    on compression. Both coefficients dimensionless, ≥ 0."""
 
-    Parameters
-    ----------
-    young : float
-        Young's modulus E (Pa), > 0.
-    poisson : float
-        Poisson's ratio ν, in (-1, 0.5).
-    density : float
-        Reference mass density ρ₀ (kg/m³), ≥ 0.
-    yield_stress : float
-        Initial yield stress σ_y0 (Pa, in Kirchhoff stress), > 0.
-    hardening_modulus : float
-        Linear isotropic hardening modulus H = dσ_y/dε̄p (Pa), ≥ 0.
-    """
-
-    young: float
-    poisson: float
-    density: float
-    yield_stress: float
-    hardening_modulus: float = 0.0
+    linear: float = 0.06
+    quadratic: float = 1.5
 
     def __post_init__(self) -> None:
-        # reuse the elastic checks (numbers, E > 0, ν in (-1, 0.5), ρ ≥ 0)
-        IsotropicElastic(self.young, self.poisson, self.density)
-        for name in ("yield_stress", "hardening_modulus"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float, np.number)):
-                raise ValueError(f"{name} must be a number (Pa), got {value!r}")
-        if not np.isfinite(self.yield_stress) or self.yield_stress <= 0.0:
-            raise ValueError(f"yield stress must be positive, got yield_stress={self.yield_stress}")
-        if not np.isfinite(self.hardening_modulus) or self.hardening_modulus < 0.0:
-            raise ValueError(
-                f"hardening modulus must be >= 0, got hardening_modulus={self.hardening_modulus}"
-            )
-
-    @property
-    def elastic(self) -> IsotropicElastic:
-        """The elastic part as an :class:`IsotropicElastic`."""
-        return IsotropicElastic(self.young, self.poisson, self.density)
-
-    @property
-    def shear_modulus(self) -> float:
-        """G = E / (2(1+ν)) (Pa)."""
-        return self.elastic.shear_modulus
-
-    @property
-    def bulk_modulus(self) -> float:
-        """K = E / (3(1−2ν)) (Pa)."""
-        return self.elastic.bulk_modulus
-
-    @property
-    def dilatational_wave_speed(self) -> float:
-        """c_d = √((K + 4G/3)/ρ₀) (m/s), the speed that sets the explicit stable step."""
-        return float(np.sqrt((self.bulk_modulus + 4.0 * self.shear_modulus / 3.0) / self.density))
-
-
-@dataclass(frozen=True)
-class PlasticState:
-    """State at the quadrature points (never mutated; the integrator commits trial states).
-
-    Attributes
-    ----------
-    cp_inv : ndarray, shape (3, 3, n_elems, n_qp)
-        Inverse plastic right Cauchy–Green tensor C_p⁻¹ (dimensionless, det = 1).
-    eqps : ndarray, shape (n_elems, n_qp)
-        Equivalent plastic strain ε̄p (dimensionless).
-    kirchhoff : ndarray, shape (3, 3, n_elems, n_qp)
-        Kirchhoff stress τ = J σ (Pa) of the last evaluation (post-processing only).
-    jacobian : ndarray, shape (n_elems, n_qp)
-        det F of the last evaluation (post-processing: σ = τ / J).
-    """
-
-    cp_inv: np.ndarray
-    eqps: np.ndarray
-    kirchhoff: np.ndarray
-    jacobian: np.ndarray
-
-    @property
-    def cauchy(self) -> np.ndarray:
-        """Cauchy stress σ = τ / J (Pa), shape (3, 3, n_elems, n_qp)."""
-        return self.kirchhoff / self.jacobian
-
-
-def _sym_eig(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Eigen-decomposition of symmetric (3, 3, ...) tensors.
-
-    Returns values (3, ...) and vectors (3, 3, ...), the i-th vector being ``vectors[:, i]``.
-    """
-    w, v = np.linalg.eigh(np.moveaxis(a, (0, 1), (-2, -1)))
-    # contiguous copies: einsum on the strided views is an order of magnitude slower
-    return (
-        np.ascontiguousarray(np.moveaxis(w, -1, 0)),
-        np.ascontiguousarray(np.moveaxis(v, (-2, -1), (0, 1))),
-    )
-
-
-def _sym_eig_planar(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """As :func:`_sym_eig` for tensors whose third axis is principal (a_02 = a_12 = 0).
-
-    Closed form for the in-plane 2×2 block (plane strain, axisymmetry), about 4× faster than
-    LAPACK's batched ``eigh`` here.
-    """
-    a00, a11, a01 = a[0, 0], a[1, 1], a[0, 1]
-    mean = 0.5 * (a00 + a11)
-    radius = np.hypot(0.5 * (a00 - a11), a01)
-    angle = 0.5 * np.arctan2(2.0 * a01, a00 - a11)
-    cos, sin = np.cos(angle), np.sin(angle)
-    values = np.stack([mean + radius, mean - radius, a[2, 2]])
-    vectors = np.zeros_like(a)
-    vectors[0, 0], vectors[1, 0] = cos, sin
-    vectors[0, 1], vectors[1, 1] = -sin, cos
-    vectors[2, 2] = 1.0
-    return values, vectors
-
-
-def _from_principal(values: np.ndarray, vectors: np.ndarray) -> np.ndarray:
-    """Σ_i values_i n_i ⊗ n_i with n_i = vectors[:, i]; shapes (3, ...), (3, 3, ...)."""
-    return np.einsum("ik...,k...,jk...->ij...", vectors, values, vectors)
-
-
-def hencky_j2_return(
-    be_trial: np.ndarray, eqps: np.ndarray, material: J2Material, planar: bool = False
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Exponential-map radial return from a trial elastic left Cauchy–Green tensor.
-
-    Parameters
-    ----------
-    be_trial : ndarray, shape (3, 3, ...)
-        Trial b_e = F̄ C_p⁻¹ F̄ᵀ (symmetric positive definite).
-    eqps : ndarray, shape (...)
-        Equivalent plastic strain at the start of the step.
-    material : J2Material
-    planar : bool
-        The third axis is principal (plane strain, axisymmetry): closed-form 2×2 eigenvalues.
-
-    Returns
-    -------
-    tau : ndarray (3, 3, ...)
-        Kirchhoff stress (Pa).
-    be : ndarray (3, 3, ...)
-        Updated elastic left Cauchy–Green tensor.
-    eqps_new : ndarray (...)
-    delta_gamma : ndarray (...)
-        Plastic multiplier of the step (0 where elastic).
-    """
-    lam2, vec = _sym_eig_planar(be_trial) if planar else _sym_eig(be_trial)
-    if not np.all(lam2 > 0.0):
-        raise InvertedElementError(
-            f"trial elastic stretch tensor is not positive definite (min eigenvalue "
-            f"{float(np.min(lam2)):.3e})"
-        )
-    eps = 0.5 * np.log(lam2)  # principal Hencky strains, (3, ...)
-    K, G, H = material.bulk_modulus, material.shear_modulus, material.hardening_modulus
-    tr = eps.sum(axis=0)
-    dev = eps - tr / 3.0
-    s_trial = 2.0 * G * dev  # principal dev τ
-    norm = np.sqrt(np.sum(s_trial**2, axis=0))
-    f = norm - SQRT23 * (material.yield_stress + H * eqps)
-    plastic = f > 0.0
-    dgamma = np.where(plastic, f / (2.0 * G + 2.0 / 3.0 * H), 0.0)
-    # unit return direction; where elastic (or ‖dev τ‖ = 0) it is multiplied by dgamma = 0
-    direction = s_trial / np.where(norm > 0.0, norm, 1.0)
-    eps_new = eps - dgamma * direction
-    tau_principal = K * tr + 2.0 * G * (eps_new - tr / 3.0)
-    tau = _from_principal(tau_principal, vec)
-    be = _from_principal(np.exp(2.0 * eps_new), vec)
-    return tau, be, eqps + SQRT23 * dgamma, dgamma
-
-
-def _inv3(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Inverse and determinant of (3, 3, ...) tensors by cofactors (vectorised)."""
-    c = np.empty_like(a)
-    c[0, 0] = a[1, 1] * a[2, 2] - a[1, 2] * a[2, 1]
-    c[0, 1] = a[0, 2] * a[2, 1] - a[0, 1] * a[2, 2]
-    c[0, 2] = a[0, 1] * a[1, 2] - a[0, 2] * a[1, 1]
-    c[1, 0] = a[1, 2] * a[2, 0] - a[1, 0] * a[2, 2]
-    c[1, 1] = a[0, 0] * a[2, 2] - a[0, 2] * a[2, 0]
-    c[1, 2] = a[0, 2] * a[1, 0] - a[0, 0] * a[1, 2]
-    c[2, 0] = a[1, 0] * a[2, 1] - a[1, 1] * a[2, 0]
-    c[2, 1] = a[0, 1] * a[2, 0] - a[0, 0] * a[2, 1]
-    c[2, 2] = a[0, 0] * a[1, 1] - a[0, 1] * a[1, 0]
-    det = a[0, 0] * c[0, 0] + a[0, 1] * c[1, 0] + a[0, 2] * c[2, 0]
-    return c / det, det
+        for name in ("linear", "quadratic"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v >= 0.0):
+                raise ValueError(f"bulk viscosity coefficient {name} must be >= 0, got {v}")
 
 
 class FiniteStrainJ2:
@@ -257,56 +80,76 @@ class FiniteStrainJ2:
     fbar : bool
         Use the F-bar deformation gradient (default). Without it, isochoric plastic flow
         locks the bilinear cells.
+    backend : {"auto", "numba", "numpy"}
+        ``auto``: the compiled kernel for planar cells with a built-in hardening law, numpy
+        otherwise (3D cells, user hardening callables).
+    bulk_viscosity : BulkViscosity or bool, optional
+        Artificial bulk viscosity (True: the default coefficients).
+    validate, allow_seams : bool
+        Mesh checks (see :class:`~arlequin.models.LinearElastic`).
 
     Notes
     -----
     Quadrature: 2×2 (2×2×2) Gauss points; F-bar uses the cell's mean dilatation J̄. Dofs are
-    interleaved by node like :class:`~arlequin.models.LinearElastic`
-    (``dim * node + component``), and :meth:`mass`, :meth:`stiffness` (small-strain elastic, for
-    stable-step estimates) come from a :class:`~arlequin.models.LinearElastic` on the same mesh
-    and quadrature. Capabilities (:mod:`arlequin.contract`): ``"critical_time_step"`` in the
-    current configuration; no ``"tangent"``: the model is meant for explicit central
-    differences (implicit schemes refuse it, or use ``newton="initial"``).
+    interleaved by node (``dim * node + component``); :meth:`mass` and :meth:`stiffness`
+    (small-strain elastic, for stable-step estimates) come from a
+    :class:`~arlequin.models.LinearElastic` on the same mesh and quadrature. Capabilities
+    (:mod:`arlequin.contract`): ``"critical_time_step"`` in the current configuration; no
+    ``"tangent"`` (explicit dynamics; implicit schemes refuse it, or use ``newton="initial"``).
+    ``uses_time_step`` is True when the state update needs the step (rate-dependent hardening,
+    bulk viscosity): the integrators then pass ``dt=`` to :meth:`internal_force`.
     """
 
     is_linear = False
 
     def __init__(
         self, mesh: Mesh, material: J2Material, kind: str | None = None, fbar: bool = True, *,
+        backend: str = "auto", bulk_viscosity: BulkViscosity | bool | None = None,
         validate: bool = True, allow_seams: bool = False,
     ) -> None:  # fmt: skip
-        if not isinstance(mesh, MeshQuad | MeshHex):
-            raise ValueError(
-                f"FiniteStrainJ2 needs a MeshQuad (axisymmetric, plane strain) or a MeshHex (3d) "
-                f"mesh, got {type(mesh).__name__}: linear simplices lock under plastic flow"
-            )
+        if not isinstance(material, J2Material):
+            raise ValueError(f"material must be a J2Material, got {type(material).__name__}")
         dim = mesh.dim()
-        if kind is None:
-            kind = "axisymmetric" if dim == 2 else "3d"
-        if kind not in KINDS or (kind == "3d") != (dim == 3):
-            raise ValueError(f"kind={kind!r} does not fit a {dim}D mesh; use one of {KINDS}")
+        kind = ("axisymmetric" if dim == 2 else "3d") if kind is None else kind
+        if backend not in BACKENDS:
+            raise ValueError(f"backend must be one of {BACKENDS}, got {backend!r}")
         self.mesh = mesh
         self.material = material
         self.kind = kind
         self.fbar = bool(fbar)
         self.dim = dim
         self.intorder = 3
-        # checks r >= 0 in axisymmetry; gives the mass, the small-strain stiffness and the bases
         checks = {"validate": validate, "allow_seams": allow_seams}
+        # checks r >= 0 in axisymmetry; gives the mass, the small-strain stiffness and the bases
         self.elastic = LinearElastic(mesh, material.elastic, kind, intorder=self.intorder, **checks)
         self.basis = self.elastic.basis
-        sb = self.elastic.scalar_basis()
-        self._t = np.asarray(mesh.t)  # (n_nodes_per_cell, n_elems)
-        nen = self._t.shape[0]
-        # reference gradients ∇_X N_a and values N_a: (nen, dim, ne, nq), (nen, ne, nq)
-        self._grad = np.stack([sb.basis[a][0].grad for a in range(nen)])
-        self._val = np.stack([np.asarray(sb.basis[a][0]) for a in range(nen)])
-        x = np.asarray(sb.global_coordinates())
-        self._radius = x[0] if kind == "axisymmetric" else None  # R at qp, (ne, nq)
-        measure = 2.0 * np.pi * x[0] if kind == "axisymmetric" else 1.0
-        self._dv0 = np.asarray(sb.dx) * measure  # reference volume per qp (m³ or m² per m)
-        self._dofs = np.asarray(self.elastic.basis.nodal_dofs)  # (dim, n_nodes)
-        self._cell_dofs = self._dofs[:, self._t]  # (dim, nen, ne)
+        self.kin = Q1Kinematics(
+            mesh, kind, self.elastic.scalar_basis(), self.elastic.basis.nodal_dofs
+        )
+        compiled = dim == 2 and material.law.kernel_code is not None
+        if backend == "numba" and not compiled:
+            raise ValueError(
+                "backend='numba' needs planar cells (axisymmetric, plane strain) and a built-in "
+                "hardening law; use backend='numpy'"
+            )
+        self.backend = "numba" if (backend == "auto" and compiled) else backend
+        if self.backend == "auto":
+            self.backend = "numpy"
+        if bulk_viscosity is True:
+            bulk_viscosity = BulkViscosity()
+        self.bulk_viscosity = bulk_viscosity or None
+        self.uses_time_step = bool(self.bulk_viscosity) or material.law.rate_dependent
+        # reference cell size ℓ₀ (m): √(meridional area) in 2D, ∛(volume) in 3D
+        area = self.kin.dv0.sum(axis=1) / self._measure_factor()
+        self._h0 = np.sqrt(area) if dim == 2 else np.cbrt(area)
+        self._critical_ratio: np.ndarray | None = None
+        self._kernel_static: tuple | None = None  # contiguous inputs and scratch of the kernel
+        self._ones: np.ndarray | None = None
+
+    def _measure_factor(self) -> np.ndarray:
+        if self.kind == "axisymmetric":
+            return 2.0 * np.pi * self.kin.radius.mean(axis=1)
+        return np.ones(self.kin.shape[0])
 
     # ------------------------------------------------------------------ model protocol
     @property
@@ -321,15 +164,17 @@ class FiniteStrainJ2:
     @property
     def shape(self) -> tuple[int, int]:
         """(n_elems, n_qp) of the quadrature-point arrays."""
-        return self._dv0.shape
+        return self.kin.shape
 
     def with_mesh(self, mesh: Mesh) -> FiniteStrainJ2:
-        """Same material, kinematics and F-bar choice on another mesh."""
-        return FiniteStrainJ2(mesh, self.material, self.kind, self.fbar, validate=False)
+        """Same material, kinematics, F-bar choice, backend and viscosity on another mesh."""
+        backend = self.backend if self.backend != "numba" or mesh.dim() == 2 else "auto"
+        return FiniteStrainJ2(mesh, self.material, self.kind, self.fbar, backend=backend,
+                              bulk_viscosity=self.bulk_viscosity, validate=False)  # fmt: skip
 
     def nodal_dofs(self) -> np.ndarray:
         """Dof indices per node, shape (dim, n_nodes)."""
-        return self._dofs
+        return self.kin.dofs
 
     def dofs_where(self, where, components=None) -> np.ndarray:
         """Dofs of the nodes where ``where(x)`` holds (see :meth:`LinearElastic.dofs_where`)."""
@@ -360,46 +205,34 @@ class FiniteStrainJ2:
         return self.elastic.traction_vector(facets, traction, weight)
 
     def initial_state(self, weight: WeightLike = None) -> PlasticState:
-        """Virgin state: C_p⁻¹ = 1, ε̄p = 0, τ = 0, J = 1."""
+        """Virgin state: C_p⁻¹ = 1, ε̄p = 0, τ = 0, J = 1, no work."""
         ne, nq = self.shape
         eye = np.broadcast_to(np.eye(3)[:, :, None, None], (3, 3, ne, nq)).copy()
         zeros = np.zeros((ne, nq))
-        return PlasticState(eye, zeros, np.zeros((3, 3, ne, nq)), np.ones((ne, nq)))
+        return PlasticState(eye, zeros, np.zeros((3, 3, ne, nq)), np.ones((ne, nq)), zeros,
+                            zeros.copy())  # fmt: skip
 
     # ------------------------------------------------------------------ kinematics
-    def _cell_displacements(self, u: np.ndarray) -> np.ndarray:
-        """Nodal displacements per cell, shape (dim, nen, ne)."""
-        u = np.asarray(u, dtype=float)
-        if u.shape != (self.n_dofs,):
-            raise ValueError(f"displacement must have shape ({self.n_dofs},), got {u.shape}")
-        return u[self._cell_dofs]
-
     def deformation_gradient(self, u: np.ndarray) -> np.ndarray:
         """Deformation gradient at the quadrature points, shape (3, 3, n_elems, n_qp).
 
         In 2D, F_zz = 1 (plane strain) or F_θθ = 1 + u_r/R (axisymmetric).
         """
-        ue = self._cell_displacements(u)
-        d = self.dim
-        F = np.zeros((3, 3, *self.shape))
-        F[:d, :d] = np.einsum("iae,ajeq->ijeq", ue, self._grad)
-        for i in range(3):
-            F[i, i] += 1.0
-        if self.kind == "axisymmetric":
-            F[2, 2] += np.einsum("ae,aeq->eq", ue[0], self._val) / self._radius
-        return F
+        return self.kin.deformation_gradient(u)
 
-    def _kinematics(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, Any]:
-        """F, F⁻¹, J = det F (checked > 0) and the F-bar factor (J̄/J)^{1/3} (1 without F-bar)."""
-        F = self.deformation_gradient(u)
-        Finv, J = _inv3(F)
-        self._check_jacobian(J)
-        scale = np.cbrt(self._mean_dilatation(J) / J) if self.fbar else 1.0
-        return F, Finv, J, scale
+    def _kinematics(self, u: np.ndarray):
+        return self.kin.kinematics(u, self.fbar)
+
+    def _mean_dilatation(self, J: np.ndarray) -> np.ndarray:
+        return self.kin.mean_dilatation(J)
 
     # ------------------------------------------------------------------ internal force
     def internal_force(
-        self, u: np.ndarray, state: PlasticState | None = None, weight: WeightLike = None
+        self,
+        u: np.ndarray,
+        state: PlasticState | None = None,
+        weight: WeightLike = None,
+        dt: float | None = None,
     ) -> tuple[np.ndarray, PlasticState]:
         """Internal force (N) at displacement ``u`` from the committed ``state``.
 
@@ -411,6 +244,9 @@ class FiniteStrainJ2:
             Committed state (default: virgin).
         weight : float, array (n_elems, n_qp) or callable, optional
             Partition weight α at the quadrature points.
+        dt : float, optional
+            The step that leads to u (s): rates of rate-dependent laws and of the bulk
+            viscosity (ignored by rate-independent models without viscosity).
 
         Returns
         -------
@@ -424,77 +260,139 @@ class FiniteStrainJ2:
             When det F ≤ 0 (or is not finite) at a quadrature point, naming the cell.
         """
         state = self.initial_state() if state is None else state
-        alpha = self.elastic.weight_at_quadrature(weight)
-        F, Finv, J, scale = self._kinematics(u)
-        # spatial gradients ∇ₓN_a = F⁻ᵀ ∇_X N_a (in-plane block) and the hoop term N_a / r
-        d = self.dim
-        gx = np.einsum("akeq,kjeq->ajeq", self._grad, Finv[:d, :d])
-        hoop = None
-        if self.kind == "axisymmetric":
-            hoop = self._val / (self._radius * F[2, 2])  # N_a / r, (nen, ne, nq)
-        Fbar = F * scale
-        be_trial = np.einsum("ikeq,kleq,jleq->ijeq", Fbar, state.cp_inv, Fbar)
-        tau, be, eqps, _ = hencky_j2_return(
-            be_trial, state.eqps, self.material, planar=self.dim == 2
+        if weight is None:  # the common case: one array of ones, made once
+            if self._ones is None:
+                self._ones = np.ones(self.shape)
+            alpha = self._ones
+        else:
+            alpha = self.elastic.weight_at_quadrature(weight)
+        if state.plastic_work is None:  # a state built by hand: no work accumulated yet
+            zeros = np.zeros(self.shape)
+            state = PlasticState(state.cp_inv, state.eqps, state.kirchhoff, state.jacobian,
+                                 zeros, zeros.copy())  # fmt: skip
+        if self.backend == "numba":
+            return self._internal_force_numba(u, state, alpha, dt)
+        return self._internal_force_numpy(u, state, alpha, dt)
+
+    def _viscous_pressure(self, jbar: np.ndarray, jbar_old: np.ndarray, dt: float | None):
+        """q (Pa) per cell, shape (n_elems, 1), of the bulk viscosity (0 where off/expanding)."""
+        if not self.bulk_viscosity or dt is None or not dt > 0.0:
+            return np.zeros_like(jbar)
+        rate = (jbar - jbar_old) / (dt * jbar)
+        ell = self._h0[:, None] * np.sqrt(jbar)
+        rho = self.material.density / jbar
+        bv, cd = self.bulk_viscosity, self.material.dilatational_wave_speed
+        q = rho * (bv.quadratic * ell**2 * rate**2 - bv.linear * ell * cd * rate)
+        return np.where(rate < 0.0, q, 0.0)
+
+    def _internal_force_numpy(self, u, state, alpha, dt):
+        trial = self.kin.trial_elastic_stretch(u, state.cp_inv, self.fbar)
+        F, Finv, J = trial.F, trial.Finv, trial.J
+        tau, be, eqps, dgamma, work = j2_return_map(
+            trial.B, state.eqps, self.material, planar=self.dim == 2, dt=dt,
+            minus_identity=True, log_volume=trial.log_volume,
+        )  # fmt: skip
+        Fbar_inv = Finv / trial.scale
+        # C_p⁻¹ = F̄⁻¹ b_e F̄⁻ᵀ changes only where the point flowed (elsewhere: kept bit for bit)
+        cp_inv = np.where(
+            dgamma > 0.0,
+            np.einsum("ikeq,kleq,jleq->ijeq", Fbar_inv, be, Fbar_inv),
+            state.cp_inv,
         )
-        Fbar_inv = Finv / scale
-        cp_inv = np.einsum("ikeq,kleq,jleq->ijeq", Fbar_inv, be, Fbar_inv)
-        w0 = alpha * self._dv0
-        # f_{a,i} = Σ w0 [τ_ij ∇ₓN_a,j + (hoop) + p (div̄ − div) δ_i]
-        fe = np.einsum("ijeq,ajeq,eq->iae", tau[:d, :d], gx, w0)
-        if self.kind == "axisymmetric":
-            fe[0] += np.einsum("eq,aeq,eq->ae", tau[2, 2], hoop, w0)
-        if self.fbar:
-            # div N_a e_i = ∇ₓN_a,i (+ N_a / r for i = r); div̄ its J-weighted cell average
-            div = gx.copy()
-            if self.kind == "axisymmetric":
-                div[:, 0] += hoop
-            jw = J * self._dv0
-            div_mean = np.einsum("aieq,eq->aie", div, jw) / jw.sum(axis=1)
-            p = np.einsum("iieq->eq", tau) / 3.0
-            fe += np.einsum("eq,aieq,eq->iae", p, div_mean[..., None] - div, w0)
-        f = np.bincount(self._cell_dofs.ravel(), weights=fe.ravel(), minlength=self.n_dofs)
-        return f, PlasticState(cp_inv, eqps, tau, J)
+        w0 = alpha * self.kin.dv0
+        jbar = self._mean_dilatation(J)
+        q = self._viscous_pressure(jbar, self._mean_dilatation(state.jacobian), dt)
+        tau_total = tau - (J * q)[None, None] * np.eye(3)[:, :, None, None]
+        f = self.kin.internal_force(tau_total, F, Finv, J, w0, self.fbar)
+        wv = state.viscous_work + q * (self._mean_dilatation(state.jacobian) - jbar)
+        return f, PlasticState(cp_inv, eqps, tau, J, state.plastic_work + work, wv)
 
-    def _mean_dilatation(self, J: np.ndarray) -> np.ndarray:
-        """J̄ = v_e / V_e per cell (current over reference volume), shape (n_elems, 1)."""
-        return (J * self._dv0).sum(axis=1, keepdims=True) / self._dv0.sum(axis=1, keepdims=True)
+    def _internal_force_numba(self, u, state, alpha, dt):
+        from .j2_kernel import planar_j2_kernel, scratch
 
-    def _check_jacobian(self, J: np.ndarray) -> None:
-        bad = ~(J > 0.0)
-        if np.any(bad):
-            cell = int(np.nonzero(bad.any(axis=1))[0][0])
-            raise InvertedElementError(
-                f"inverted or degenerate cell {cell}: det F = {float(np.min(J[cell])):.3e} "
-                f"({int(bad.any(axis=1).sum())} such cells)"
-            )
+        kin = self.kin
+        ne, nq = self.shape
+        nen = kin.grad.shape[0]
+        law = self.material.law
+        if self._kernel_static is None:
+            c = np.ascontiguousarray
+            radius = kin.radius if kin.radius is not None else np.ones((ne, nq))
+            visc = np.zeros(4)
+            if self.bulk_viscosity:
+                bv = self.bulk_viscosity
+                visc[:] = (bv.linear, bv.quadratic, self.material.density,
+                           self.material.dilatational_wave_speed)  # fmt: skip
+            self._kernel_static = (
+                c(np.transpose(kin.cell_dofs, (2, 1, 0)), dtype=np.int64),
+                c(np.moveaxis(kin.grad, (0, 1), (2, 3))), c(np.moveaxis(kin.val, 0, -1)),
+                c(radius), c(kin.dv0),
+                visc, c(self._h0), *scratch(nq, nen),
+            )  # fmt: skip
+        dofs, grad, val, radius, dv0, visc, h0, s_h, s_g, s_u = self._kernel_static
+        u = np.ascontiguousarray(u, dtype=float)
+        if u.shape != (kin.n_dofs,):
+            raise ValueError(f"displacement must have shape ({kin.n_dofs},), got {u.shape}")
+        out = [np.empty((2, nen, ne)), np.empty((3, 3, ne, nq)), np.empty((ne, nq)),
+               np.empty((3, 3, ne, nq)), np.empty((ne, nq)), np.empty((ne, nq)),
+               np.empty((ne, nq)), np.empty(ne, dtype=np.int64)]  # fmt: skip
+        c = np.ascontiguousarray
+        planar_j2_kernel(
+            u, dofs, grad, val, radius, dv0, c(np.broadcast_to(alpha, (ne, nq)), dtype=float),
+            self.kind == "axisymmetric", self.fbar, self.material.bulk_modulus,
+            self.material.shear_modulus, int(law.kernel_code), law.kernel_params,
+            -1.0 if dt is None else float(dt), c(state.cp_inv), c(state.eqps),
+            c(state.plastic_work), c(state.viscous_work), c(state.jacobian), visc, h0,
+            s_h, s_g, s_u, *out,
+        )  # fmt: skip
+        fe, cp_inv, eqps, tau, J, wp, wv, flags = out
+        if np.any(flags):
+            bad = np.nonzero(flags)[0]
+            cell = int(bad[0])
+            if flags[cell] == 1:
+                raise InvertedElementError(
+                    f"inverted or degenerate cell {cell}: det F <= 0 ({bad.size} such cells)"
+                )
+            raise StateError(f"J2 return map not converged in cell {cell}")
+        f = np.bincount(kin.cell_dofs.ravel(), weights=fe.ravel(), minlength=kin.n_dofs)
+        return f, PlasticState(cp_inv, eqps, tau, J, wp, wv)
 
     # ------------------------------------------------------------------ post-processing
     def stored_energy(self, u: np.ndarray, state: PlasticState, weight: WeightLike = None) -> float:
         """Elastic stored energy Σ w₀ ψ(ε_e) of a committed state at ``u`` (J)."""
         alpha = self.elastic.weight_at_quadrature(weight)
-        F, _, _, scale = self._kinematics(u)
-        Fbar = F * scale
-        be = np.einsum("ikeq,kleq,jleq->ijeq", Fbar, state.cp_inv, Fbar)
-        eps = 0.5 * np.log((_sym_eig_planar(be) if self.dim == 2 else _sym_eig(be))[0])
-        tr = eps.sum(axis=0)
+        trial = self.kin.trial_elastic_stretch(u, state.cp_inv, self.fbar)
+        dev = hencky_strain(trial.B, self.dim == 2, minus_identity=True)[0]
+        tr = trial.log_volume
         K, G = self.material.bulk_modulus, self.material.shear_modulus
-        psi = 0.5 * K * tr**2 + G * np.sum((eps - tr / 3.0) ** 2, axis=0)
-        return float(np.sum(alpha * self._dv0 * psi))
+        psi = 0.5 * K * tr**2 + G * np.sum(dev**2, axis=0)
+        return float(np.sum(alpha * self.kin.dv0 * psi))
+
+    def plastic_dissipation(self, state: PlasticState, weight: WeightLike = None) -> float:
+        """Accumulated plastic work Σ w₀ w_p (J)."""
+        alpha = self.elastic.weight_at_quadrature(weight)
+        return float(np.sum(alpha * self.kin.dv0 * state.plastic_work))
+
+    def viscous_dissipation(self, state: PlasticState, weight: WeightLike = None) -> float:
+        """Accumulated work of the bulk viscosity Σ w₀ w_v (J)."""
+        alpha = self.elastic.weight_at_quadrature(weight)
+        return float(np.sum(alpha * self.kin.dv0 * state.viscous_work))
 
     def critical_time_step(self, u: np.ndarray, state: PlasticState | None = None) -> float:
-        """Element estimate (s) of the explicit critical step in the configuration X + u.
+        """Estimate (s) of the explicit critical step in the configuration X + u.
 
-        The element eigenvalue bound of :func:`~arlequin.models.elastic.element_critical_step`
-        with the small-strain elastic stiffness of the current cells and the reference lumped
-        masses (total Lagrangian): it follows cells that are crushed during a run. At u = 0 it
-        is a lower bound of the model's critical step. Capability ``"critical_time_step"``.
+        min over the cells of κ_c h_c(u)/c_d, with h_c the cell's measure over its longest edge
+        (its thickness) and κ_c calibrated once per cell so that at u = 0 the estimate is the
+        element eigenvalue bound of :func:`~arlequin.models.elastic.element_critical_step` (a
+        lower bound of the critical step). Cheap enough to follow, every few steps, the cells
+        crushed during a run. Capability ``"critical_time_step"``.
         """
-        current = type(self.mesh)(self.current_coordinates(u), self.mesh.t)
-        # the elastic integrands (material and kinematics) on the current cells
-        basis = Basis(current, self.elastic.element, intorder=self.intorder)
-        return element_critical_step(self.elastic, basis, mass_basis=self.basis)
+        cd = self.material.dilatational_wave_speed
+        if self._critical_ratio is None:
+            per_cell = element_critical_step(self.elastic, self.elastic.basis, per_cell=True)
+            self._critical_ratio = per_cell * cd / self.kin.cell_sizes(self.mesh.p)
+        h = self.kin.cell_sizes(self.current_coordinates(u))
+        return float(np.min(self._critical_ratio * h) / cd)
 
     def current_coordinates(self, u: np.ndarray) -> np.ndarray:
         """Node positions x = X + u, shape (dim, n_nodes) (m)."""
-        return self.mesh.p + np.asarray(u)[self._dofs]
+        return self.mesh.p + np.asarray(u)[self.kin.dofs]

@@ -64,9 +64,13 @@ def test_surface_weights_2d_3d():
     hexm = skfem.MeshHex.init_tensor(*axes)
     s3 = ContactSurface(hexm, where=lambda x: x[2] < 1e-9)
     assert s3.weights.sum() == pytest.approx(0.02)
-    # axisymmetric: ∫ 2πr over the disc of radius 0.3
+    # axisymmetric: ∫ N_a 2πr ds, exact for r linear on each segment, so the total is the disc
+    # of radius 0.3 exactly and the node on the axis gets its share 2πℓ²/6 (ℓ its segment)
     s_axi = ContactSurface(quad, where=lambda x: x[1] < 1e-9, axisymmetric=True)
-    assert s_axi.weights.sum() == pytest.approx(np.pi * 0.3**2, rel=0.02)
+    assert s_axi.weights.sum() == pytest.approx(np.pi * 0.3**2, rel=1e-12)
+    on_axis = quad.p[0, s_axi.nodes] == 0.0
+    ell = np.diff(np.unique(quad.p[0]))[0]
+    assert s_axi.weights[on_axis] == pytest.approx([2 * np.pi * ell**2 / 6], rel=1e-12)
 
 
 @pytest.mark.parametrize("dim", [2, 3])

@@ -225,3 +225,43 @@ def test_unilateral_constraints_follow_the_protocol_and_keep_states_immutable(in
     )  # fmt: skip
     np.testing.assert_array_equal(again.active, new.active)
     assert again.work == new.work
+
+
+class _RecordsTimeStep:
+    """A nonlinear wrapper of a linear model that declares ``uses_time_step`` and records the
+    ``dt`` the integrators pass (the contract: the step that leads to u, None at t = 0)."""
+
+    is_linear = False
+    uses_time_step = True
+
+    def __init__(self, model):
+        self.model, self.n_dofs, self.seen = model, model.n_dofs, []
+
+    def mass(self, weight=None, lumped=False):
+        return self.model.mass(weight, lumped=lumped)
+
+    def stiffness(self, weight=None):
+        return self.model.stiffness(weight)
+
+    def internal_force(self, u, state=None, weight=None, dt=None):
+        self.seen.append(dt)
+        return self.model.stiffness(weight) @ u, None
+
+    def tangent(self, u, state=None, weight=None):
+        return self.model.stiffness(weight)
+
+
+@pytest.mark.parametrize("scheme", ["explicit", "newmark"])
+def test_models_that_use_the_time_step_receive_it(scheme):
+    bar = LinearElastic(skfem.MeshLine(np.linspace(0.0, 1.0, 6)), STEEL, area=1e-4)
+    model = _RecordsTimeStep(bar)
+    system = CoupledSystem([Block("b", model, [BlockTerm(model)])])
+    steps = [1e-6, 2e-6, 1.5e-6]
+    from arlequin.integrators import StepSchedule
+
+    with pytest.raises(ValueError, match="StepSchedule needs a function"):
+        StepSchedule(steps)
+    schedule = StepSchedule(lambda integ: steps[min(integ.step_count, 2)])
+    solve(system, scheme, dt=schedule, n_steps=3, v0=np.ones(bar.n_dofs))
+    assert model.seen[0] is None  # the initial evaluation
+    assert sorted(set(model.seen[1:])) == sorted(set(steps))  # every later call: its step

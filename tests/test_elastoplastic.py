@@ -90,7 +90,7 @@ def test_uniaxial_strain_matches_closed_form(strain, steps, planar):
 
 def test_planar_eigen_decomposition_matches_lapack():
     # closed-form 2×2 + out-of-plane eigenpairs rebuild the tensor, degenerate cases included
-    from arlequin.models.elastoplastic import _from_principal, _sym_eig_planar
+    from arlequin.models.j2 import _from_principal, _sym_eig_planar
 
     rng = np.random.default_rng(8)
     a = np.zeros((3, 3, 50))

@@ -193,6 +193,7 @@ class Integrator:
         self.v = v
         self.a = np.zeros_like(u)
         self.constraint_states = {c.name: c.initial_state(u, v) for c in self.unilateral}
+        self._stack_cache: dict = {}  # stack_active's last stacked rows
         self._initialize()
 
     # ------------------------------------------------------------------ scheme hooks
@@ -384,7 +385,7 @@ class Integrator:
 
     def _active(self, trials: Sequence[Any]):
         """(G_A, rhs_A, active index lists, row levels is-displacement) of the trials."""
-        g_a, rhs_a, idx = stack_active(trials, self.ops.n)
+        g_a, rhs_a, idx = stack_active(trials, self.ops.n, self._stack_cache)
         disp = np.concatenate(
             [np.full(a.size, c.level == "displacement") for c, a in zip(self.unilateral, idx)]
         ) if idx else np.zeros(0, dtype=bool)  # fmt: skip

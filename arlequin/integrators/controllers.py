@@ -117,6 +117,14 @@ class StepSchedule:
 
     schedule: Callable[[Any], float]
 
+    def __post_init__(self) -> None:
+        if not callable(self.schedule):
+            raise ValueError(
+                f"StepSchedule needs a function integrator -> dt (s), got "
+                f"{type(self.schedule).__name__} (for a list of steps: "
+                f"lambda integ: steps[min(integ.step_count, len(steps) - 1)])"
+            )
+
     def propose(self, integrator: Any) -> float:
         return check_step(self.schedule(integrator), "scheduled time step")
 

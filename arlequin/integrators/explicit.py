@@ -82,6 +82,10 @@ class _ImpulseSolver:
             self.s_ee = None
             self.lu = None
         self._cache: dict[Any, Any] = {}
+        self._last_key: tuple[Any, bytes] | None = None
+        self._eq_mask = np.zeros(inv_mass.size, dtype=bool)
+        if self.m_e:
+            self._eq_mask[rows.cols] = True
 
     def solve_equality(self, r: np.ndarray) -> np.ndarray:
         return self.lu.solve(r) if self.m_e else np.zeros(0)
@@ -93,13 +97,28 @@ class _ImpulseSolver:
             self._cache = {key: fac}
         return fac
 
+    def _key(self, g_a: sp.csr_matrix) -> bytes:
+        last = self._last_key
+        if last is not None and last[0] is g_a:  # the same stacked rows as last time
+            return last[1]
+        key = rows_key(g_a)
+        self._last_key = (g_a, key)
+        return key
+
     def solve(self, r_e: np.ndarray, g_a: sp.csr_matrix, r_a: np.ndarray):
         """Return (Λ_E, Λ_A) for right-hand sides r_e (m_E,), r_a (m_A,) and active rows g_a."""
         m_a = g_a.shape[0]
         if m_a == 0:
             return self.solve_equality(r_e), np.zeros(0)
-        key = rows_key(g_a)
+        key = self._key(g_a)
         minv = self.inv_mass
+        if self.m_e and not self._eq_mask[g_a.indices].any():
+            # no dof shared with the equality rows (a wall and a symmetry axis): two blocks
+            def build_aa_only():
+                s_aa = (g_a @ sp.diags(minv) @ g_a.T).tocsr()
+                return factor_checked(s_aa, "the impulse matrix of the active rows", spd=True)
+
+            return self.solve_equality(r_e), self._cached(key, build_aa_only).solve(r_a)
         if self.m_e == 0:
 
             def build_aa():
@@ -390,8 +409,10 @@ class CentralDifference(Integrator):
             po = po + unilateral_block_power(self.ops, self._g_a, self._lam_a / self._dt_bar, v)
         return p_ext, pc, po
 
-    def _forces(self, u: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray | None, dict]:
-        f_int, trial, _ = self.ops.internal_force(u, self.states)
+    def _forces(
+        self, u: np.ndarray, t: float, dt: float | None = None
+    ) -> tuple[np.ndarray, np.ndarray | None, dict]:
+        f_int, trial, _ = self.ops.internal_force(u, self.states, dt=dt)
         f_ext = self.system.external_force(t) if self.system.load is not None else None
         if f_ext is not None and not f_ext.any():
             f_ext = None  # unloaded at t: skip the force and its power
@@ -439,7 +460,7 @@ class CentralDifference(Integrator):
         t_new = self._end_time()
         v_half = self._v_next
         u_new = self.u + dt * v_half
-        f_int, f_ext, trial = self._forces(u_new, t_new)
+        f_int, f_ext, trial = self._forces(u_new, t_new, dt)
         a_new = self._acceleration(f_int, f_ext)
         # the step size at t is final now: commit the works of the step that ended at t
         self._w_ext, self._w_coupling, self._w_constraint = self._works()

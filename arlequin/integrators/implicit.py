@@ -244,14 +244,15 @@ class ImplicitIntegrator(Integrator):
             sol = lu.solve(rhs)
             x, mu = sol[:n], sol[n:]
             u = u_p + c_u * x
-            f_int, trial, _ = self.ops.internal_force(u, self.states)
+            f_int, trial, _ = self.ops.internal_force(u, self.states, dt=self.dt)
             self.newton_iterations = 1
             return x, mu, b, idx, f_int, trial
         # Newton: one internal-force + tangent evaluation per iteration
         x = self._x_from_state()
         mu = np.zeros(b.shape[0])
         scale0 = max(float(np.linalg.norm(known)), 1e-300)
-        f_int, trial, kt = self.ops.internal_force(u_p + c_u * x, self.states, tangent=True)
+        force = self.ops.internal_force
+        f_int, trial, kt = force(u_p + c_u * x, self.states, tangent=True, dt=self.dt)
         res = np.full(n, np.inf)
         for it in range(1, self.max_newton + 1):
             res0 = self._mass_times(c_a * x) + self.w1 * f_int - known
@@ -260,7 +261,7 @@ class ImplicitIntegrator(Integrator):
             sol = lu.solve(np.concatenate([-res0, r_rows - b @ x]))
             dx, mu = sol[:n], sol[n:]
             x = x + dx
-            f_int, trial, kt = self.ops.internal_force(u_p + c_u * x, self.states, tangent=True)
+            f_int, trial, kt = force(u_p + c_u * x, self.states, tangent=True, dt=self.dt)
             bmu = b.T @ mu if b.shape[0] else 0.0
             res = self._mass_times(c_a * x) + self.w1 * f_int - known + bmu
             scale = max(scale0, float(np.linalg.norm(self.w1 * f_int)), float(np.linalg.norm(bmu)))

@@ -46,6 +46,19 @@ class ScaledLU:
     ) -> None:
         mat = sp.csr_matrix(mat)
         n = mat.shape[0]
+        self.shape = mat.shape
+        self._inv_diag: np.ndarray | None = None
+        if _is_diagonal(mat):
+            # independent rows (a wall, a symmetry axis): no factorisation, one division
+            dg = mat.diagonal()
+            scale = np.max(np.abs(dg)) if n else 0.0
+            small = np.nonzero(~(np.abs(dg) > 1e-14 * scale))[0] if n else np.zeros(0, int)
+            if small.size:
+                i = int(small[0])
+                where = f" ({names(i)})" if names is not None else ""
+                raise ConstraintError(f"{what} has an empty row {i}{where}")
+            self._inv_diag = 1.0 / dg
+            return
         diag = np.abs(mat.diagonal())
         d = np.zeros(n)
         nz = diag > 0.0
@@ -82,12 +95,22 @@ class ScaledLU:
                 "a Dirichlet condition on dofs that the mediator rows already tie, or duplicate "
                 "rows)"
             )
-        self.shape = mat.shape
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
         """Solve A x = rhs; rhs of shape (N,) or (N, k)."""
+        if self._inv_diag is not None:
+            inv = self._inv_diag if rhs.ndim == 1 else self._inv_diag[:, None]
+            return inv * rhs
         d = self.d if rhs.ndim == 1 else self.d[:, None]
         return d * self.lu.solve(np.ascontiguousarray(d * rhs))
+
+
+def _is_diagonal(mat: sp.csr_matrix) -> bool:
+    """True if the CSR matrix has no stored entry off its diagonal (zeros pruned)."""
+    mat = mat.copy()
+    mat.eliminate_zeros()
+    rows = np.repeat(np.arange(mat.shape[0]), np.diff(mat.indptr))
+    return bool(np.all(mat.indices == rows))
 
 
 def factor_checked(

@@ -177,9 +177,12 @@ class SystemOperators:
         return ub if t.transfer is None else t.transfer @ ub
 
     def internal_force(
-        self, u: np.ndarray, states: Mapping[str, list[Any]], tangent: bool = False
-    ) -> tuple[np.ndarray, dict[str, list[Any]], sp.csr_matrix | None]:
-        """Internal force (N) at ``u`` from the committed ``states``.
+        self, u: np.ndarray, states: Mapping[str, list[Any]], tangent: bool = False,
+        dt: float | None = None,
+    ) -> tuple[np.ndarray, dict[str, list[Any]], sp.csr_matrix | None]:  # fmt: skip
+        """Internal force (N) at ``u`` from the committed ``states``; ``dt`` (s) is the step that
+        leads to ``u``, passed to the models whose ``uses_time_step`` is True (rate-dependent
+        laws, bulk viscosity; None at the initial time).
 
         Returns
         -------
@@ -190,7 +193,8 @@ class SystemOperators:
         tangent : sparse (n, n) or None
             Tangent (N/m) when ``tangent`` is True (see the ``tangent`` parameter of the class).
         """
-        f = self.stiffness @ u
+        # the assembled (linear) part; nothing to multiply when every term is nonlinear
+        f = self.stiffness @ u if self.stiffness.nnz else np.zeros(u.shape)
         trial = {name: list(s) for name, s in states.items()}
         if not self._nonlinear_terms:
             return f, trial, (self.stiffness if tangent else None)
@@ -201,7 +205,10 @@ class SystemOperators:
             b = self.blocks[bi]
             ut = self._term_u(b, term, u)
             state = states[b.name][ti]
-            ft, new_state = term.model.internal_force(ut, state, term.weight)
+            if getattr(term.model, "uses_time_step", False):
+                ft, new_state = term.model.internal_force(ut, state, term.weight, dt=dt)
+            else:
+                ft, new_state = term.model.internal_force(ut, state, term.weight)
             trial[b.name][ti] = new_state
             p = term.transfer
             f[b.dofs] += term.sign * (ft if p is None else p.T @ ft)

@@ -41,7 +41,7 @@ def rows_key(mat: sp.csr_matrix) -> bytes:
     return h.digest()
 
 
-def stack_active(trials: Sequence, n: int):
+def stack_active(trials: Sequence, n: int, cache: dict | None = None):
     """Active rows of the unilateral constraints' trials.
 
     Parameters
@@ -49,6 +49,9 @@ def stack_active(trials: Sequence, n: int):
     trials : sequence of ConstraintTrial
     n : int
         Number of global dofs.
+    cache : dict, optional
+        The caller's cache (one per integrator): the same matrices with the same active rows
+        (most steps) give the same stacked rows without rebuilding them.
 
     Returns
     -------
@@ -63,11 +66,21 @@ def stack_active(trials: Sequence, n: int):
     for tr in trials:
         act = np.nonzero(tr.active)[0]
         idx.append(act)
-        mats.append(sp.csr_matrix(tr.matrix)[act])
         rhs.append(np.asarray(tr.rhs, dtype=float)[act])
-    if not mats:
+    if not trials:
         return sp.csr_matrix((0, n)), np.zeros(0), idx
-    return sp.vstack(mats, format="csr"), np.concatenate(rhs), idx
+    # the same matrices with the same active rows (most steps): the same stacked rows
+    key = tuple((id(tr.matrix), tr.active.tobytes()) for tr in trials)
+    if cache is not None and cache.get("key") == key:
+        return cache["g_a"], np.concatenate(rhs), idx
+    for tr, act in zip(trials, idx):
+        mats.append(sp.csr_matrix(tr.matrix)[act])
+    g_a = sp.vstack(mats, format="csr")
+    if cache is not None:
+        # the matrices are kept alive with the key so that their ids cannot be reused
+        cache.clear()
+        cache.update(key=key, g_a=g_a, matrices=[tr.matrix for tr in trials])
+    return g_a, np.concatenate(rhs), idx
 
 
 def scatter_active(values: np.ndarray, idx: Sequence[np.ndarray], sizes: Sequence[int]):

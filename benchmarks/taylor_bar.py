@@ -1,0 +1,92 @@
+"""The Taylor bar on one mesh at several refinements: results, cost and the kernel's speed-up.
+
+For each level (cells across the radius) a full run (80 µs, F-bar, the compiled kernel) in its
+own process (so that its peak memory is its own), then the same mesh over a short window with the
+numpy backend and with the kernel, for the numpy/numba ratio (same steps, same process). Prints
+JSON, one record per level: cells, steps, wall time, quadrature-point updates per second of the
+explicit loop (n_qp × n_steps / loop time, contact and records included; the kernel's
+compilation and the integrator's set-up excluded), peak resident memory, the ratio, and the
+results (final length, footprint radius, maximum ε̄p, energy balance error) against the published
+values. ``--plain`` levels also run without F-bar (the locking comparison).
+
+    python benchmarks/taylor_bar.py [--levels 5 10 20 30] [--plain 10 20] [--window 1e-6]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import resource
+import subprocess
+import sys
+
+
+def one_level(n: int, fbar: bool, window: float) -> dict:
+    from arlequin.demos.taylor_bar import TAYLOR_REFERENCE, run_taylor_bar
+
+    r = run_taylor_bar(elements_radial=n, fbar=fbar)
+    ref = TAYLOR_REFERENCE
+    record = {
+        "elements_radial": n,
+        "fbar": fbar,
+        "elements": r.n_elements,
+        "quadrature_points": 4 * r.n_elements,
+        "steps": r.n_steps,
+        "wall_time_s": round(r.wall_time_s, 2),
+        "setup_time_s": round(r.setup_time_s, 2),
+        "qp_updates_per_second": float(f"{r.qp_updates_per_second:.4g}"),
+        "min_dt_s": r.min_dt,
+        "final_length_mm": round(r.final_length * 1e3, 4),
+        "mushroom_radius_mm": round(r.mushroom_radius * 1e3, 4),
+        "length_error": round(r.final_length / ref["final_length"] - 1.0, 5),
+        "radius_error": round(r.mushroom_radius / ref["mushroom_radius"] - 1.0, 5),
+        "max_plastic_strain": round(r.max_plastic_strain, 3),
+        "max_plastic_strain_at_mm": [round(x * 1e3, 4) for x in r.max_plastic_strain_at],
+        "energy_balance_error": float(f"{r.energy_balance_error:.3g}"),
+        "impact_loss_J": round(r.impact_loss, 4),
+    }
+    if fbar and window > 0:
+        # the same mesh and window with both backends: the loop time ratio
+        fast = run_taylor_bar(elements_radial=n, t_end=window, backend="numba")
+        slow = run_taylor_bar(elements_radial=n, t_end=window, backend="numpy")
+        assert fast.n_steps == slow.n_steps
+        loop = [x.wall_time_s - x.setup_time_s for x in (slow, fast)]
+        record["numpy_numba_ratio"] = round(loop[0] / loop[1], 2)
+        record["ratio_window_s"] = window
+        record["ratio_window_steps"] = fast.n_steps
+    record["peak_rss_mib"] = round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, 1)
+    return record
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--levels", type=int, nargs="+", default=[5, 10, 20, 30])
+    parser.add_argument("--plain", type=int, nargs="*", default=[10, 20],
+                        help="levels also run without F-bar")  # fmt: skip
+    parser.add_argument("--window", type=float, default=1e-6,
+                        help="simulated time (s) of the numpy/numba comparison")  # fmt: skip
+    parser.add_argument("--single", type=int, default=None, help=argparse.SUPPRESS)
+    parser.add_argument("--no-fbar", action="store_true", help=argparse.SUPPRESS)
+    args = parser.parse_args(argv)
+    if args.single is not None:
+        print(json.dumps(one_level(args.single, not args.no_fbar, args.window)))
+        return 0
+    # compile (or load) the kernel once, outside every measurement
+    from arlequin.models.j2_kernel import warm_up
+
+    warm_up()
+    records = []
+    runs = [(n, True) for n in args.levels] + [(n, False) for n in args.plain]
+    for n, fbar in runs:
+        cmd = [sys.executable, __file__, "--single", str(n), "--window", str(args.window)]
+        if not fbar:
+            cmd.append("--no-fbar")
+        out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
+        records.append(json.loads(out.strip().splitlines()[-1]))
+        print(json.dumps(records[-1]), file=sys.stderr, flush=True)
+    print(json.dumps({"benchmark": "taylor_bar", "levels": records}, indent=2))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,172 @@
+"""The compiled J2 kernel (models/j2_kernel.py) against the numpy reference path.
+
+Both evaluate the same formulas (Q1 kinematics with F-bar, b_e − 1 without round-off, the
+exponential-map return, the bulk viscosity, the consistent force), one point by point and one
+with arrays, so they must agree to round-off: 1e-12 relative to the largest entry of each output
+on random displacements and random committed states (elastic, plastic and mixed cells).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import skfem
+from _meshes import perturb
+
+from arlequin.contract import StateError
+from arlequin.models import (
+    CallableHardening,
+    FiniteStrainJ2,
+    InvertedElementError,
+    J2Material,
+    JohnsonCookHardening,
+    VoceHardening,
+)
+
+COPPER = J2Material(117e9, 0.35, 8930.0, 0.4e9, 0.1e9)  # Taylor-bar copper (DESIGN §4)
+MATERIALS = {
+    "linear": COPPER,
+    "voce": J2Material.with_law(117e9, 0.35, 8930.0, VoceHardening(0.4e9, 0.2e9, 8.0, 0.05e9)),
+    "johnson-cook-rate": J2Material.with_law(
+        117e9, 0.35, 8930.0, JohnsonCookHardening(0.4e9, 0.3e9, 0.4, c=0.02)
+    ),
+}
+RTOL = 1e-12
+
+
+def mesh(n: int = 4, seed: int = 1) -> skfem.Mesh:
+    m = skfem.MeshQuad.init_tensor(np.linspace(0.0, 3.2e-3, n + 1), np.linspace(0.0, 4e-3, n + 2))
+    return perturb(m, 3.2e-3 / n, 0.25, seed)
+
+
+def pair(kind, name, fbar=True, **kwargs):
+    m = mesh()
+    mat = MATERIALS[name]
+    return (FiniteStrainJ2(m, mat, kind, fbar, backend="numpy", **kwargs),
+            FiniteStrainJ2(m, mat, kind, fbar, backend="numba", **kwargs))  # fmt: skip
+
+
+def random_u(model, amplitude, seed, compress=0.0):
+    """Random nodal displacement (strains ~ amplitude) plus an axial compression."""
+    rng = np.random.default_rng(seed)
+    u = amplitude * 1e-3 * rng.uniform(-1, 1, model.n_dofs)
+    u[model.nodal_dofs()[1]] -= compress * model.mesh.p[1]
+    return u
+
+
+def assert_same(a, b, what):
+    fa, sa = a
+    fb, sb = b
+    for name, x, y in [
+        ("force", fa, fb),
+        ("cp_inv", sa.cp_inv, sb.cp_inv),
+        ("eqps", sa.eqps, sb.eqps),
+        ("kirchhoff", sa.kirchhoff, sb.kirchhoff),
+        ("jacobian", sa.jacobian, sb.jacobian),
+        ("plastic_work", sa.plastic_work, sb.plastic_work),
+        ("viscous_work", sa.viscous_work, sb.viscous_work),
+    ]:
+        scale = max(np.abs(x).max(), 1e-300)
+        err = np.abs(x - y).max() / scale
+        assert err <= RTOL, f"{what}: {name} differs by {err:.2e} (relative)"
+
+
+@pytest.mark.parametrize("kind", ["axisymmetric", "plane_strain"])
+@pytest.mark.parametrize("name", sorted(MATERIALS))
+@pytest.mark.parametrize("fbar", [True, False])
+def test_kernel_equals_numpy_on_random_states(kind, name, fbar):
+    ref, fast = pair(kind, name, fbar)
+    dt = 1e-7
+    # elastic (strains 1e-9 and 1e-4), mixed and fully plastic evaluations from the virgin state
+    for amplitude, compress in [(1e-9, 0.0), (1e-4, 0.0), (2e-3, 2e-3), (0.05, 0.2)]:
+        u = random_u(ref, amplitude, seed=3, compress=compress)
+        a, b = ref.internal_force(u, dt=dt), fast.internal_force(u, dt=dt)
+        assert_same(a, b, f"first step, strain ~{amplitude}")
+        plastic = a[1].eqps > 0
+        if amplitude >= 2e-3:
+            assert plastic.any()
+    # a second step from a committed plastic state, unloading in part of the mesh (mixed)
+    u1 = random_u(ref, 0.05, seed=4, compress=0.2)
+    s1 = ref.internal_force(u1, dt=dt)[1]
+    u2 = u1 + random_u(ref, 0.01, seed=5, compress=-0.01)
+    a, b = ref.internal_force(u2, s1, dt=dt), fast.internal_force(u2, s1, dt=dt)
+    assert_same(a, b, "second step")
+    grew = a[1].eqps > s1.eqps
+    assert grew.any() and not grew.all()  # both branches at once
+
+
+@pytest.mark.parametrize("kind", ["axisymmetric", "plane_strain"])
+def test_kernel_equals_numpy_with_bulk_viscosity_and_weight(kind):
+    ref, fast = pair(kind, "linear", bulk_viscosity=True)
+    assert ref.uses_time_step and fast.uses_time_step
+    rng = np.random.default_rng(2)
+    alpha = rng.uniform(0.1, 1.0, ref.shape)
+    u1 = random_u(ref, 0.02, seed=6, compress=0.1)
+    s1 = ref.internal_force(u1, weight=alpha, dt=1e-7)[1]
+    u2 = u1 + random_u(ref, 0.001, seed=7, compress=0.01)  # compressing further: q > 0
+    a = ref.internal_force(u2, s1, weight=alpha, dt=1e-8)
+    b = fast.internal_force(u2, s1, weight=alpha, dt=1e-8)
+    assert_same(a, b, "bulk viscosity")
+    assert ref.viscous_dissipation(a[1], alpha) > 0.0
+
+
+def test_kernel_and_numpy_agree_on_the_smallest_strains():
+    # b_e − 1 is assembled without forming 1 + ε: the force stays linear in u down to 1e-15
+    ref, fast = pair("axisymmetric", "linear")
+    u = random_u(ref, 1.0, seed=8)
+    f1 = fast.internal_force(1e-6 * u)[0]
+    for scale in [1e-9, 1e-12]:
+        for model in (ref, fast):
+            f = model.internal_force(scale * 1e-6 * u)[0]
+            assert np.allclose(f, scale * f1, rtol=0, atol=1e-5 * scale * np.abs(f1).max())
+
+
+def test_kernel_reports_an_inverted_cell_by_id():
+    _, fast = pair("plane_strain", "linear")
+    p = fast.mesh.p
+    corner = int(np.argmax(p[0] + p[1]))  # the top-right corner node: in one cell only
+    cell = int(np.nonzero((fast.mesh.t == corner).any(axis=0))[0][0])
+    u = np.zeros(fast.n_dofs)
+    u[fast.nodal_dofs()[:, corner]] = -2e-3  # pushed across the cell's diagonal
+    with pytest.raises(InvertedElementError, match=f"cell {cell}: det F <= 0 \\(1 such cells\\)"):
+        fast.internal_force(u)
+
+
+def test_backend_choice():
+    m = mesh()
+    user = J2Material.with_law(
+        117e9, 0.35, 8930.0, CallableHardening(lambda e, r: 4e8 + 1e8 * e, lambda e, r: 1e8 + 0 * e)
+    )
+    assert FiniteStrainJ2(m, COPPER).backend == "numba"  # planar + built-in law
+    assert FiniteStrainJ2(m, user).backend == "numpy"  # user callable: numpy only
+    with pytest.raises(ValueError, match="backend='numba' needs"):
+        FiniteStrainJ2(m, user, backend="numba")
+    with pytest.raises(ValueError, match="backend must be one of"):
+        FiniteStrainJ2(m, COPPER, backend="cuda")
+    hexes = skfem.MeshHex.init_tensor(*[np.linspace(0, 1e-3, 2)] * 3)
+    assert FiniteStrainJ2(hexes, COPPER).backend == "numpy"
+
+
+def test_callable_law_matches_the_built_in_one():
+    # the same linear law as a user callable (numpy path, Newton) and built in (the kernel)
+    m = mesh()
+    user = J2Material.with_law(
+        117e9, 0.35, 8930.0,
+        CallableHardening(lambda e, r: 0.4e9 + 0.1e9 * e, lambda e, r: 0.1e9 + 0.0 * e),
+    )  # fmt: skip
+    a = FiniteStrainJ2(m, user, "axisymmetric")
+    b = FiniteStrainJ2(m, COPPER, "axisymmetric")
+    u = random_u(a, 0.05, seed=9, compress=0.2)
+    assert_same(a.internal_force(u), b.internal_force(u), "callable vs built-in")
+
+
+def test_return_map_failure_is_a_state_error():
+    # a user law that returns NaN once the point flows: reported, never propagated
+    bad = J2Material.with_law(
+        117e9, 0.35, 8930.0,
+        CallableHardening(lambda e, r: np.where(e > 0, np.nan, 0.4e9), lambda e, r: 0.0 * e),
+    )  # fmt: skip
+    model = FiniteStrainJ2(mesh(), bad, "plane_strain")
+    u = random_u(model, 0.05, seed=10, compress=0.2)
+    with pytest.raises(StateError, match="plastic multiplier not converged"):
+        model.internal_force(u)
