@@ -9,70 +9,18 @@ series that ParaView opens, pictures; see :mod:`arlequin.io`).
 from __future__ import annotations
 
 import argparse
-import json
 import logging
-import math
-import os
 import sys
 from collections.abc import Sequence
 
+from .cli_common import NonFiniteResult
+from .cli_common import add_out as _add_out
+from .cli_common import check_writable as _check_writable
+from .cli_common import write_json as _write_json
+from .cli_taylor import add_taylor_bar
 from .contract import SimulationError
 
 __all__ = ["main"]
-
-
-class NonFiniteResult(RuntimeError):
-    """A command computed a NaN or an infinite value (the run is reported as failed)."""
-
-
-def _non_finite(data, prefix: str = "") -> list[str]:
-    """Keys of non-finite numbers in a JSON-like document."""
-    out: list[str] = []
-    if isinstance(data, dict):
-        for k, v in data.items():
-            out += _non_finite(v, f"{prefix}{k}.")
-    elif isinstance(data, (list, tuple)):
-        for i, v in enumerate(data):
-            out += _non_finite(v, f"{prefix}{i}.")
-    elif isinstance(data, float) and not math.isfinite(data):
-        out.append(f"{prefix[:-1]}={data}")
-    elif isinstance(data, str) and data in ("nan", "inf", "-inf"):
-        out.append(f"{prefix[:-1]}={data}")
-    return out
-
-
-def _check_results(data: dict) -> None:
-    bad = _non_finite(data)
-    if bad:
-        shown = ", ".join(bad[:5]) + (f" and {len(bad) - 5} more" if len(bad) > 5 else "")
-        raise NonFiniteResult(f"the run produced non-finite results: {shown}")
-
-
-def _write_json(path: str | None, data: dict) -> None:
-    _check_results(data)
-    if path:
-        with open(path, "w", encoding="utf-8") as fh:
-            json.dump(data, fh, indent=2)
-
-
-def _check_writable(path: str | None, option: str) -> None:
-    """Refuse, before any computation, an output file whose folder cannot be written."""
-    if not path:
-        return
-    folder = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(folder) or not os.access(folder, os.W_OK):
-        raise ValueError(
-            f"{option} {path!r}: the folder {folder!r} does not exist or is not writable"
-        )
-
-
-def _add_out(p: argparse.ArgumentParser) -> None:
-    p.add_argument(
-        "--out",
-        metavar="DIR",
-        default=None,
-        help="write a results folder: results.json, history.csv, fields/*.xdmf, pictures",
-    )
 
 
 def _cmd_patch_test(args: argparse.Namespace) -> int:
@@ -239,175 +187,6 @@ def _add_wave(sub) -> None:
     p.set_defaults(func=_cmd_wave)
 
 
-def _progress_bar(total: float, quiet: bool):
-    """A tqdm bar over the simulated time (µs) with ETA on stderr, or None when quiet."""
-    if quiet:
-        return None, None
-    from tqdm import tqdm
-
-    bar = tqdm(
-        total=round(total * 1e6, 3),
-        unit="µs",
-        desc="simulated time",
-        leave=False,
-        bar_format="{l_bar}{bar}| {n:.1f}/{total:.1f} µs [{elapsed}<{remaining}]",
-    )
-
-    def update(t: float) -> None:
-        bar.n = round(t * 1e6, 3)
-        bar.refresh()
-
-    return bar, update
-
-
-def _cmd_taylor_bar(args: argparse.Namespace) -> int:
-    from .demos.taylor_bar import run_taylor_bar
-
-    law_params = {
-        k: getattr(args, k)
-        for k in ("voce_saturation", "voce_rate", "jc_b", "jc_n", "jc_c", "jc_reference_rate")
-    }
-    law_params = {k: v for k, v in law_params.items() if v is not None}
-    bar, update = _progress_bar(args.t_end, args.quiet)
-    try:
-        result = run_taylor_bar(
-            model=args.model,
-            elements_radial=args.elements_radial,
-            mesh_size=args.mesh_size,
-            t_end=args.t_end,
-            velocity=args.velocity,
-            young=args.young,
-            poisson=args.poisson,
-            density=args.density,
-            yield_stress=args.yield_stress,
-            hardening=args.hardening,
-            hardening_law=args.hardening_law,
-            length=args.length,
-            radius=args.radius,
-            bulk_viscosity=args.bulk_viscosity,
-            fbar=not args.no_fbar,
-            backend=args.backend,
-            out=args.out,
-            progress=update,
-            **law_params,
-        )
-    finally:
-        if bar is not None:
-            bar.close()
-    print(result.summary())
-    _write_json(args.json, result.to_json())
-    return 0
-
-
-def _add_taylor_bar(sub) -> None:
-    p = sub.add_parser(
-        "taylor-bar",
-        help="Taylor bar impact: a copper bar hits a rigid wall (finite-strain J2, axisymmetric)",
-        description="A bar (length L, radius R) moving at V hits a rigid frictionless wall at "
-        "t = 0; axisymmetric Q1 F-bar cells, central differences with the step re-estimated "
-        "in the current configuration, the level-set contact model at the wall. SI units. "
-        "Reports the final length, the footprint (mushroom) radius, the maximum equivalent "
-        "plastic strain and the energy balance error (a fraction).",
-    )
-    p.add_argument(
-        "--model",
-        choices=["mono"],
-        default="mono",
-        help="mono: one finite-strain mesh over the whole bar",
-    )
-    size = p.add_mutually_exclusive_group()
-    size.add_argument(
-        "--elements-radial",
-        type=int,
-        default=None,
-        metavar="N",
-        help="cells across the radius (default 10); the axial count is round(L/h)",
-    )
-    size.add_argument(
-        "--mesh-size", type=float, default=None, metavar="H", help="cell edge across the radius (m)"
-    )
-    p.add_argument("--t-end", type=float, default=80e-6, metavar="T", help="end time (s)")
-    p.add_argument("--velocity", type=float, default=227.0, metavar="V", help="impact speed (m/s)")
-    p.add_argument("--young", type=float, default=117e9, metavar="E", help="Young's modulus (Pa)")
-    p.add_argument("--poisson", type=float, default=0.35, metavar="NU", help="Poisson's ratio")
-    p.add_argument("--density", type=float, default=8930.0, metavar="RHO", help="density (kg/m^3)")
-    p.add_argument(
-        "--yield-stress", type=float, default=0.4e9, metavar="S", help="initial yield stress (Pa)"
-    )
-    p.add_argument(
-        "--hardening",
-        type=float,
-        default=0.1e9,
-        metavar="H",
-        help="linear hardening modulus (Pa; the linear term of the Voce law)",
-    )
-    p.add_argument("--hardening-law", choices=["linear", "voce", "johnson-cook"], default="linear")
-    p.add_argument(
-        "--voce-saturation",
-        type=float,
-        default=None,
-        metavar="Q",
-        help="Voce: saturation stress Q (Pa, default 0.1e9)",
-    )
-    p.add_argument(
-        "--voce-rate",
-        type=float,
-        default=None,
-        metavar="B",
-        help="Voce: saturation rate b (default 10)",
-    )
-    p.add_argument(
-        "--jc-b",
-        type=float,
-        default=None,
-        metavar="B",
-        help="Johnson-Cook: B (Pa, default 0.292e9; A is --yield-stress)",
-    )
-    p.add_argument(
-        "--jc-n",
-        type=float,
-        default=None,
-        metavar="N",
-        help="Johnson-Cook: exponent n (default 0.31)",
-    )
-    p.add_argument(
-        "--jc-c",
-        type=float,
-        default=None,
-        metavar="C",
-        help="Johnson-Cook: strain-rate coefficient C (default 0: off)",
-    )
-    p.add_argument(
-        "--jc-reference-rate",
-        type=float,
-        default=None,
-        metavar="R",
-        help="Johnson-Cook: reference strain rate (1/s, default 1)",
-    )
-    p.add_argument("--length", type=float, default=32.4e-3, metavar="L", help="bar length (m)")
-    p.add_argument("--radius", type=float, default=3.2e-3, metavar="R", help="bar radius (m)")
-    p.add_argument(
-        "--bulk-viscosity",
-        action="store_true",
-        help="artificial bulk viscosity (linear 0.06, quadratic 1.5)",
-    )
-    p.add_argument(
-        "--no-fbar",
-        action="store_true",
-        help="plain Q1 cells (they lock under plastic flow; for comparison)",
-    )
-    p.add_argument(
-        "--backend",
-        choices=["auto", "numba", "numpy"],
-        default="auto",
-        help="internal-force path (auto: the compiled kernel)",
-    )
-    p.add_argument("--json", metavar="PATH", default=None, help="write the results as JSON")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
-    _add_out(p)
-    p.set_defaults(func=_cmd_taylor_bar)
-
-
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="arlequin", description="Arlequin multiscale coupling: demos and verification."
@@ -417,7 +196,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_patch_test(sub)
     _add_two_bars(sub)
     _add_wave(sub)
-    _add_taylor_bar(sub)
+    add_taylor_bar(sub)
     return parser
 
 

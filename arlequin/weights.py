@@ -4,8 +4,8 @@ In the overlap S of a coarse model and a patch, α_coarse + α_fine = 1. With ``
 from a point of the patch to the patch's *interior boundary* (the part of its boundary inside the
 coarse domain) and ``w`` the gluing-band width:
 
-``RampWeights``      α_coarse = 1 − (1 − ε) min(d / w, 1)   (continuous, α_fine = 0 on the
-                     interior boundary; piecewise linear in d)
+``RampWeights``      α_coarse = a − (a − ε) min(d / w, 1)   (continuous, α_coarse = a on the
+                     interior boundary, default a = 1; piecewise linear in d)
 ``ConstantWeights``  α_coarse = ``value`` for d < w, ε beyond (cell-wise constant)
 ``CallableWeights``  user functions α_coarse(x), α_fine(x)
 
@@ -72,12 +72,32 @@ class PartitionWeights:
 
 @dataclass(frozen=True)
 class RampWeights(PartitionWeights):
-    """Linear ramp across the gluing band: α_coarse goes from 1 (interior boundary) to ε."""
+    """Linear ramp across the gluing band: α_coarse goes from ``edge`` (interior boundary) to ε.
 
+    Attributes
+    ----------
+    edge : float
+        α_coarse on the patch's interior boundary, in (ε, 1]; default 1 (the fine model carries
+        nothing there). A value below 1 keeps some weight, hence mass and stiffness, on the
+        fine model's edge: in explicit dynamics the mediator's impulses act on the edge nodes
+        whatever their weight, and nodes of vanishing mass then take large fine-scale velocity
+        corrections (see the Taylor bar in ``docs/arlequin_taylor.md``).
+    """
+
+    edge: float = 1.0
     mode = "nodal"
 
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if not self.epsilon < self.edge <= 1.0:
+            raise ValueError(
+                f"ramp edge weight must lie in (epsilon, 1] = ({self.epsilon}, 1], got "
+                f"edge={self.edge}"
+            )
+
     def alpha_coarse(self, x, d, width):
-        return 1.0 - (1.0 - self.epsilon) * np.minimum(np.asarray(d, dtype=float) / width, 1.0)
+        ramp = np.minimum(np.asarray(d, dtype=float) / width, 1.0)
+        return self.edge - (self.edge - self.epsilon) * ramp
 
 
 @dataclass(frozen=True)

@@ -24,7 +24,7 @@ import sys
 def one_level(n: int, fbar: bool, window: float) -> dict:
     from arlequin.demos.taylor_bar import TAYLOR_REFERENCE, run_taylor_bar
 
-    r = run_taylor_bar(elements_radial=n, fbar=fbar)
+    r = run_taylor_bar(model="mono", elements_radial=n, fbar=fbar)
     ref = TAYLOR_REFERENCE
     record = {
         "elements_radial": n,
@@ -47,8 +47,8 @@ def one_level(n: int, fbar: bool, window: float) -> dict:
     }
     if fbar and window > 0:
         # the same mesh and window with both backends: the loop time ratio
-        fast = run_taylor_bar(elements_radial=n, t_end=window, backend="numba")
-        slow = run_taylor_bar(elements_radial=n, t_end=window, backend="numpy")
+        fast = run_taylor_bar(model="mono", elements_radial=n, t_end=window, backend="numba")
+        slow = run_taylor_bar(model="mono", elements_radial=n, t_end=window, backend="numpy")
         assert fast.n_steps == slow.n_steps
         loop = [x.wall_time_s - x.setup_time_s for x in (slow, fast)]
         record["numpy_numba_ratio"] = round(loop[0] / loop[1], 2)

@@ -28,35 +28,35 @@ from __future__ import annotations
 import logging
 import math
 import time
+import warnings
 from collections.abc import Callable
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import scipy.sparse as sp
-import skfem
 
 from ..integrators import CriticalFraction, solve
-from ..io import JsonResult, ResultsFolder
-from ..models import (
-    HARDENING_LAWS,
-    BulkViscosity,
-    ContactSurface,
-    FiniteStrainJ2,
-    J2Material,
-    LevelSetContact,
-    PlaneObstacle,
-    RigidContactPair,
-    make_hardening,
+from ..io import ResultsFolder
+from ..models import HARDENING_LAWS, BulkViscosity, J2Material, make_hardening
+from ..weights import PartitionWeights
+from .taylor_models import ArlequinBar, MonoBar, arlequin_bar_sizes, taylor_bar_mesh
+from .taylor_record import HISTORY_UNITS, MultiplierHistory, TaylorRecorder, write_results
+from .taylor_result import (
+    ARLEQUIN_JSON_KEYS,
+    JSON_KEYS,
+    MODELS,
+    TAYLOR_REFERENCE,
+    GluingBandPlasticityWarning,
+    TaylorBarResult,
 )
-from ..system import Block, BlockTerm, CoupledSystem, LinearConstraint
-from .taylor_record import HISTORY_UNITS, TaylorRecorder, write_results
 
 __all__ = [
+    "ARLEQUIN_JSON_KEYS",
     "HISTORY_UNITS",
     "JSON_KEYS",
+    "MODELS",
     "TAYLOR_REFERENCE",
+    "GluingBandPlasticityWarning",
     "TaylorBarResult",
     "hardening_parameters",
     "run_taylor_bar",
@@ -64,23 +64,6 @@ __all__ = [
 ]
 
 logger = logging.getLogger(__name__)
-
-#: The keys of the JSON document of ``arlequin taylor-bar --json`` (the Interface of issue 10).
-JSON_KEYS = (
-    "final_length",
-    "mushroom_radius",
-    "max_plastic_strain",
-    "energy_balance_error",
-    "n_elements",
-    "mesh_size",
-    "n_steps",
-    "wall_time_s",
-    "history",
-)
-
-
-#: Published converged values at 80 µs (DESIGN §4: 3D, 1.5M elements), m.
-TAYLOR_REFERENCE = {"final_length": 21.43e-3, "mushroom_radius": 7.23e-3}
 
 #: Default parameters of each hardening law (Pa, dimensionless, 1/s); σ_y0 and H come from
 #: ``yield_stress`` and ``hardening`` for every law.
@@ -104,111 +87,11 @@ _RESULT_UNITS = {
     "energy_balance_error": "1", "n_elements": "1", "mesh_size": "m", "n_steps": "1",
     "wall_time_s": "s", "initial_kinetic_energy": "J", "impact_loss": "J", "min_dt": "s",
     "max_plastic_strain_at": "m", "final_energies": "J", "qp_updates_per_second": "1/s",
-    "setup_time_s": "s",
+    "setup_time_s": "s", "coarse_elements": "1", "fine_elements": "1", "coarse_size": "m",
+    "fine_size": "m", "patch_fraction": "1", "patch_length": "m", "gluing_width": "m",
+    "band_max_plastic_strain": "1", "multiplier_chatter": "1",
+    "multiplier_chatter_per_row": "1",
 }  # fmt: skip
-
-
-@dataclass
-class TaylorBarResult(JsonResult):
-    """One Taylor bar run (SI units).
-
-    Attributes
-    ----------
-    final_length : float
-        Axial position of the top-face node on the axis at the end (m).
-    mushroom_radius : float
-        Largest distance from the axis of a node of the impact face at the end (m).
-    max_plastic_strain : float
-        Largest equivalent plastic strain ε̄p over the quadrature points at the end.
-    energy_balance_error : float
-        max over the records of |KE + W_el + D_p + D_visc + W_c − KE_0| / KE_0.
-    n_elements : int
-        Cells of the mesh.
-    mesh_size : float
-        Cell edge across the radius, R / elements_radial (m).
-    n_steps : int
-        Time steps taken.
-    wall_time_s : float
-        Wall time of the run (s): the integrator's set-up (the critical step of the initial
-        configuration) and the explicit loop, compilation of the kernel excluded.
-    history : dict
-        Column -> list, one entry per record (every ``sample_interval``): t (s), length (m),
-        radius (m), kinetic, elastic, plastic_dissipation, viscous_dissipation, contact_work
-        (J; contact_work = W_c ≥ 0, the energy removed by the wall), contact_force (N, the
-        wall's axial force averaged since the previous record, from the accumulated impulse;
-        at t = 0 that of the impulse stopping the face), dt (s, the step that ended there).
-    elements_radial, elements_axial : int
-    max_plastic_strain_at : list of float
-        Reference (r, z) of the quadrature point of the maximum ε̄p (m).
-    initial_kinetic_energy : float
-        KE_0 = ½ v₀·M v₀, lumped mass (J).
-    impact_loss : float
-        W_c after the impulse of t = 0 (J): ½ m_face v₀² of the nodes stopped by the wall.
-    min_dt : float
-        Smallest step of the run (s).
-    qp_updates_per_second : float
-        Quadrature-point updates per second of the explicit loop (contact and records
-        included), n_qp n_steps / (wall_time_s − setup_time_s).
-    setup_time_s : float
-        The set-up part of wall_time_s (s).
-    config : dict
-        The inputs.
-    reference : dict
-        The published values at 80 µs (m), :data:`TAYLOR_REFERENCE`.
-    model, u, state : the model, the final displacement (m) and the final quadrature state
-        (not in the JSON).
-    """
-
-    final_length: float
-    mushroom_radius: float
-    max_plastic_strain: float
-    energy_balance_error: float
-    n_elements: int
-    mesh_size: float
-    n_steps: int
-    wall_time_s: float
-    history: dict[str, list[float]]
-    elements_radial: int
-    elements_axial: int
-    max_plastic_strain_at: list[float]
-    initial_kinetic_energy: float
-    impact_loss: float
-    min_dt: float
-    qp_updates_per_second: float
-    setup_time_s: float
-    config: dict[str, Any] = field(default_factory=dict)
-    reference: dict[str, float] = field(default_factory=lambda: dict(TAYLOR_REFERENCE))
-    model: Any = field(default=None, repr=False)
-    u: Any = field(default=None, repr=False)
-    state: Any = field(default=None, repr=False)
-
-    json_exclude = ("model", "u", "state")
-
-    def to_json(self) -> dict[str, Any]:
-        data = super().to_json()
-        # the Interface keys first, then the rest
-        return {**{k: data[k] for k in JSON_KEYS}, **{k: v for k, v in data.items()
-                                                       if k not in JSON_KEYS}}  # fmt: skip
-
-    def summary(self) -> str:
-        ref = TAYLOR_REFERENCE
-        return (
-            f"Taylor bar, {self.elements_radial} x {self.elements_axial} cells: final length "
-            f"{self.final_length * 1e3:.3f} mm ({self.final_length / ref['final_length'] - 1:+.2%}"
-            f" vs 21.43), mushroom radius {self.mushroom_radius * 1e3:.3f} mm "
-            f"({self.mushroom_radius / ref['mushroom_radius'] - 1:+.2%} vs 7.23), max plastic "
-            f"strain {self.max_plastic_strain:.3f}, energy balance error "
-            f"{self.energy_balance_error:.2e}, {self.n_steps} steps in {self.wall_time_s:.1f} s"
-        )
-
-
-def taylor_bar_mesh(length: float, radius: float, elements_radial: int) -> skfem.MeshQuad:
-    """Meridional (r, z) Q1 mesh of the bar: ``elements_radial`` cells across the radius and
-    round(L / h) along the axis, h = R / elements_radial (nearly square cells), z ∈ [0, L]."""
-    n_r = int(elements_radial)
-    n_z = max(1, round(length / (radius / n_r)))
-    return skfem.MeshQuad.init_tensor(np.linspace(0.0, radius, n_r + 1),
-                                      np.linspace(0.0, length, n_z + 1))  # fmt: skip
 
 
 def hardening_parameters(law: str, yield_stress: float, hardening: float, **params: float):
@@ -258,8 +141,18 @@ def _elements_radial(elements_radial, mesh_size, radius) -> int:
     return int(n)
 
 
+def _fine_radial(elements_radial, mesh_size, fine_size, radius) -> int:
+    """Fine cells across the radius from the three aliases (the Arlequin and graded models)."""
+    given = [(k, v) for k, v in (("elements_radial", elements_radial), ("mesh_size", mesh_size),
+                                 ("fine_size", fine_size)) if v is not None]  # fmt: skip
+    if len(given) > 1:
+        raise ValueError(f"give one of elements_radial, mesh_size or fine_size, got {dict(given)}")
+    size = fine_size if fine_size is not None else mesh_size
+    return _elements_radial(elements_radial, size, radius)
+
+
 def run_taylor_bar(
-    model: str = "mono",
+    model: str = "arlequin",
     elements_radial: int | None = None,
     mesh_size: float | None = None,
     t_end: float = 80e-6,
@@ -274,6 +167,15 @@ def run_taylor_bar(
     radius: float = 3.2e-3,
     bulk_viscosity: bool | BulkViscosity = False,
     *,
+    patch_length: float | None = None,
+    gluing_width: float | None = None,
+    coarse_size: float | None = None,
+    fine_size: float | None = None,
+    weights: str | PartitionWeights = "ramp",
+    mediator: str = "fine",
+    coupling: str = "H1",
+    coarse_step_ratio: int = 1,
+    band_warning: float = 0.02,
     fbar: bool = True,
     backend: str = "auto",
     safety: float = 0.8,
@@ -284,15 +186,19 @@ def run_taylor_bar(
     progress: Callable[[float], None] | None = None,
     **law_parameters: float,
 ) -> TaylorBarResult:
-    """Run the Taylor bar impact on one axisymmetric mesh (see the module docstring).
+    """Run the Taylor bar impact (see the module docstring).
 
     Parameters
     ----------
-    model : {"mono"}
-        One finite-strain mesh over the whole bar (the Arlequin variant comes next).
+    model : {"arlequin", "mono"}
+        ``"arlequin"`` (default): a coarse linear-elastic bar plus a refined finite-strain J2
+        patch over the impacted end (:class:`~arlequin.demos.taylor_models.ArlequinBar`);
+        ``"mono"``: one finite-strain mesh over the whole bar.
     elements_radial : int, optional
-        Cells across the radius (default 10); or ``mesh_size`` (m), the cell edge across the
-        radius (then elements_radial = round(R / mesh_size)). The axial count is round(L / h).
+        Cells across the radius (default 10; the fine cells of the patch under ``arlequin``); or
+        ``mesh_size`` (m), the cell edge across the radius (then elements_radial =
+        round(R / mesh_size)); under ``arlequin`` also ``fine_size``, an alias of ``mesh_size``.
+        The axial count is round(L / h).
     t_end : float
         End time (s), default 80 µs.
     velocity : float
@@ -306,6 +212,25 @@ def run_taylor_bar(
         Bar length L and radius R (m).
     bulk_viscosity : bool or BulkViscosity
         Artificial bulk viscosity (off by default; True: linear 0.06, quadratic 1.5).
+    patch_length, gluing_width, coarse_size : float, optional
+        ``arlequin`` only (m): the patch's length from the impact face (default 0.9 L), the
+        gluing band's width at its top (default two coarse rows), both rounded to whole coarse
+        rows, and the coarse cell edge across the radius (default twice the fine size, or the
+        smallest multiple dividing the radius); see
+        :func:`~arlequin.demos.taylor_models.arlequin_bar_sizes`.
+    weights, mediator, coupling : str
+        ``arlequin`` only: ``"ramp"`` (default), ``"constant"`` (½ in the band) or any
+        :class:`~arlequin.PartitionWeights`; the ``"fine"`` (default) or ``"coarse"`` mediator
+        space; ``"H1"`` (default) or ``"L2"`` coupling. The fine mediator ties the patch to the
+        coarse field everywhere in the band; the coarse one leaves the patch's fine-scale motion
+        free there, and where the ramp makes the patch light (its top edge) the mediator's
+        impulses raise spurious plastic flow (docs/arlequin_taylor.md).
+    coarse_step_ratio : int
+        ``arlequin`` only: coarse steps per patch step; 1 (the default, one step for the coupled
+        system) is the only value implemented so far.
+    band_warning : float
+        ``arlequin`` only: warn (:class:`GluingBandPlasticityWarning`) when ε̄p in the gluing
+        band exceeds this (default 0.02): the coarse model there is elastic.
     fbar : bool
         F-bar cells (default); False gives the plain (locking) Q1 cells.
     backend : {"auto", "numba", "numpy"}
@@ -333,13 +258,43 @@ def run_taylor_bar(
         run fails (an inverted cell names the cell, the step and the time), with the results
         folder marked failed and everything recorded until then kept.
     """
-    if model != "mono":
-        raise ValueError(f"model must be 'mono' (one mesh over the whole bar), got {model!r}")
+    if model not in MODELS:
+        raise ValueError(f"model must be one of {MODELS}, got {model!r}")
     for name, value in [("t_end", t_end), ("velocity", velocity), ("length", length),
                         ("radius", radius), ("sample_interval", sample_interval),
                         ("frame_interval", frame_interval)]:  # fmt: skip
         _positive(name, value)
-    n_r = _elements_radial(elements_radial, mesh_size, radius)
+    arlequin = model == "arlequin"
+    if not arlequin:
+        extra = {k: v for k, v in (("patch_length", patch_length), ("gluing_width", gluing_width),
+                                   ("coarse_size", coarse_size)) if v is not None}  # fmt: skip
+        if extra:
+            raise ValueError(f"{sorted(extra)} apply to model='arlequin' only, got model={model!r}")
+        if fine_size is not None:
+            raise ValueError(f"fine_size applies to model='arlequin' only (use mesh_size), got "
+                             f"model={model!r}")  # fmt: skip
+        n_r = _elements_radial(elements_radial, mesh_size, radius)
+    else:
+        n_r = _fine_radial(elements_radial, mesh_size, fine_size, radius)
+    if coarse_step_ratio != 1:
+        if isinstance(coarse_step_ratio, bool) or int(coarse_step_ratio) != coarse_step_ratio \
+                or coarse_step_ratio < 1:  # fmt: skip
+            raise ValueError(
+                f"coarse_step_ratio must be a positive integer, got {coarse_step_ratio!r}"
+            )
+        raise ValueError(
+            f"coarse_step_ratio={coarse_step_ratio}: multi-time-step is not implemented yet; "
+            "the coupled system advances with one step (coarse_step_ratio=1)"
+        )
+    if not isinstance(weights, PartitionWeights) and weights not in ("ramp", "constant"):
+        raise ValueError(f"weights must be 'ramp', 'constant' or a PartitionWeights, got "
+                         f"weights={weights!r}")  # fmt: skip
+    for name, value, choices in (("mediator", mediator, ("coarse", "fine")),
+                                 ("coupling", coupling, ("L2", "H1"))):  # fmt: skip
+        if value not in choices:
+            raise ValueError(f"{name} must be one of {choices}, got {name}={value!r}")
+    if not (isinstance(band_warning, (int, float)) and band_warning >= 0.0):
+        raise ValueError(f"band_warning must be a non-negative number, got {band_warning!r}")
     law = hardening_parameters(hardening_law, yield_stress, hardening, **law_parameters)
     material = J2Material.with_law(young, poisson, density, law)
     if int(estimate_every) != estimate_every or estimate_every < 1:
@@ -352,10 +307,23 @@ def run_taylor_bar(
     if not isinstance(fbar, bool):
         raise ValueError(f"fbar must be True or False, got fbar={fbar!r}")
     visc = BulkViscosity() if bulk_viscosity is True else (bulk_viscosity or None)
-    mesh = taylor_bar_mesh(length, radius, n_r)
-    n_z = mesh.t.shape[1] // n_r
-    config = {
-        "model": model, "elements_radial": n_r, "elements_axial": n_z, "mesh_size": radius / n_r,
+    config: dict[str, Any] = {"model": model}
+    if arlequin:
+        sizes = arlequin_bar_sizes(length, radius, n_r, coarse_size, patch_length, gluing_width)
+        bar: MonoBar | ArlequinBar = ArlequinBar(
+            length, radius, sizes, material, weights=weights, mediator=mediator,
+            coupling=coupling, fbar=fbar, backend=backend, bulk_viscosity=visc,
+        )  # fmt: skip
+        n_z = sizes.patch_rows * sizes.ratio
+        config.update(sizes.as_dict(), weights=str(weights), mediator=mediator, coupling=coupling,
+                      coarse_step_ratio=int(coarse_step_ratio), band_warning=band_warning,
+                      epsilon=1e-3)  # fmt: skip
+    else:
+        bar = MonoBar(length, radius, n_r, material, fbar, backend, visc)
+        n_z = bar.mesh.t.shape[1] // n_r
+    fine_model = bar.model
+    config.update({
+        "elements_radial": n_r, "elements_axial": n_z, "mesh_size": radius / n_r,
         "t_end": t_end, "velocity": velocity, "young": young, "poisson": poisson,
         "density": density, "yield_stress": yield_stress, "hardening": hardening,
         "hardening_law": hardening_law, "length": length, "radius": radius,
@@ -363,56 +331,32 @@ def run_taylor_bar(
         "estimate_every": int(estimate_every), "sample_interval": sample_interval,
         "frame_interval": frame_interval,
         **{k: v for k, v in law_parameters.items() if v is not None},
-    }  # fmt: skip
+    })  # fmt: skip
     if visc:
         config.update(bulk_viscosity_linear=visc.linear, bulk_viscosity_quadratic=visc.quadratic)
-    bar = FiniteStrainJ2(mesh, material, "axisymmetric", fbar, backend=backend,
-                         bulk_viscosity=visc)  # fmt: skip
-    if bar.backend == "numba":
+    if fine_model.backend == "numba":
         from ..models.j2_kernel import warm_up
 
         warm_up()  # compile (or load) the kernel before the clock starts
-    dofs = bar.nodal_dofs()
-    p = mesh.p
-    tol = 1e-9 * radius
-    axis = np.nonzero(p[0] < tol)[0]
-    rows = sp.csr_matrix((np.ones(axis.size), (np.arange(axis.size), dofs[0, axis])),
-                         shape=(axis.size, bar.n_dofs))  # fmt: skip
-    system = CoupledSystem(
-        [Block("bar", bar, [BlockTerm(bar)])],
-        [LinearConstraint(rows, None, name="axis", kind="dirichlet")],
-    )
-    # the impact face and the lower part of the lateral surface (it folds onto the wall)
-    lateral = 0.3 * length
-
-    def on_wall_side(x):
-        return (x[1] < tol) | ((x[0] > radius - tol) & (x[1] < lateral))
-
-    surface = ContactSurface(mesh, where=on_wall_side, offset=system.dofmap["bar"],
-                             axisymmetric=True)  # fmt: skip
-    wall = PlaneObstacle(np.zeros(2), np.array([0.0, 1.0]))
-    con = LevelSetContact(RigidContactPair(surface, wall, system.dofmap), material=material.elastic,
-                          name="wall")  # fmt: skip
-    v0 = np.zeros(bar.n_dofs)
-    v0[dofs[1]] = -velocity
-    m_lumped = bar.mass(lumped=True)
-    ke0 = 0.5 * float(v0 @ (m_lumped * v0))
-    axis_top = int(np.nonzero((p[0] < tol) & (p[1] > length - tol))[0][0])
-    face = np.nonzero(p[1] < tol)[0]
+    v0 = bar.initial_velocity(velocity)
+    ke0 = 0.5 * float(v0 @ (bar.lumped_mass() * v0))
     frames = np.arange(0.0, t_end * (1 + 1e-12), frame_interval)
     # every input checked: the results folder opens (results.json with the inputs, "running")
     folder = None
     if out is not None:
         folder = ResultsFolder(out, "arlequin taylor-bar", config, _INPUT_UNITS)
-    rec = TaylorRecorder(bar, con.name, surface.weights, axis_top, face, ke0, folder, frames,
-                         progress)  # fmt: skip
+    con = bar.contact
+    rec = TaylorRecorder(bar, con.name, con.pair.slave.weights, ke0, folder, frames, progress)
+    lam_history = MultiplierHistory("coupling:patch") if arlequin else None
     n_samples = max(1, round(t_end / sample_interval))
     t_eval = np.linspace(0.0, t_end, n_samples + 1)[1:]
-    logger.info("Taylor bar: %d x %d cells, %s backend", n_r, n_z, bar.backend)
+    logger.info("Taylor bar (%s): %d x %d fine cells, %s backend", model, n_r, n_z,
+                fine_model.backend)  # fmt: skip
     start = time.perf_counter()
     try:
-        res = solve(system, "explicit", t_end=t_end, v0=v0, constraints=[con],
-                    step_controller=controller, t_eval=t_eval, on_record=[rec])  # fmt: skip
+        res = solve(bar.system, "explicit", t_end=t_end, v0=v0, constraints=[con],
+                    step_controller=controller, t_eval=t_eval, on_record=[rec],
+                    on_step=[lam_history] if lam_history is not None else [])  # fmt: skip
     except Exception as exc:
         if folder is not None:
             folder.finish("failed", str(exc))
@@ -420,18 +364,21 @@ def run_taylor_bar(
     end = time.perf_counter()
     wall_time = end - start
     loop_time = end - (rec.loop_start if rec.loop_start is not None else start)
-    u, state = res.u, res.states["bar"][0]
+    u = res.u
+    state = res.states[bar.fine_block][0]
     ip = int(np.argmax(state.eqps))
-    xq = bar.quadrature_points().reshape(2, -1)[:, ip]
+    xq = fine_model.quadrature_points().reshape(2, -1)[:, ip]
     steps = np.asarray(res.step_sizes if res.step_sizes is not None else [res.dt])
     n_qp = state.eqps.size
     hist = rec.history
+    if not arlequin:  # the single-mesh history keeps the keys of its Interface
+        hist.pop("coupling_work")
     result = TaylorBarResult(
         final_length=hist["length"][-1],
         mushroom_radius=hist["radius"][-1],
         max_plastic_strain=float(state.eqps.max()),
         energy_balance_error=float(max(rec.balance)),
-        n_elements=int(mesh.t.shape[1]),
+        n_elements=bar.n_elements,
         mesh_size=radius / n_r,
         n_steps=int(res.n_steps),
         wall_time_s=wall_time,
@@ -445,10 +392,30 @@ def run_taylor_bar(
         qp_updates_per_second=n_qp * res.n_steps / loop_time,
         setup_time_s=wall_time - loop_time,
         config=config,
-        model=bar,
+        model=fine_model,
         u=u,
         state=state,
+        setup=bar,
     )
+    if arlequin:
+        assert isinstance(bar, ArlequinBar) and lam_history is not None
+        s = bar.sizes
+        band_eqps = bar.band_plastic_strain(state)
+        result.arlequin = {
+            "coarse_elements": bar.coarse_elements, "fine_elements": bar.fine_elements,
+            "coarse_size": s.coarse_size, "fine_size": s.fine_size,
+            "patch_fraction": bar.patch_fraction, "patch_length": s.patch_length,
+            "gluing_width": s.gluing_width, "band_max_plastic_strain": band_eqps,
+            "multiplier_chatter": lam_history.chatter()["global"],
+            "multiplier_chatter_per_row": lam_history.chatter()["per_row"],
+        }  # fmt: skip
+        result.multiplier_history = lam_history
+        if band_eqps > band_warning:
+            msg = (f"equivalent plastic strain in the gluing band reaches {band_eqps:.4f} > "
+                   f"{band_warning} (band_warning): the coarse model glued there is elastic; "
+                   f"lengthen the patch (patch_length={s.patch_length:.4g} m)")  # fmt: skip
+            warnings.warn(msg, GluingBandPlasticityWarning, stacklevel=2)
+            logger.warning(msg)
     if folder is not None:
         write_results(folder, result, _RESULT_UNITS)
     logger.info(result.summary())

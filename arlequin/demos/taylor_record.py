@@ -16,7 +16,7 @@ import numpy as np
 
 from ..io import ResultsFolder
 
-__all__ = ["HISTORY_UNITS", "TaylorRecorder", "write_results"]
+__all__ = ["HISTORY_UNITS", "MultiplierHistory", "TaylorRecorder", "write_results"]
 
 #: History columns and their units.
 HISTORY_UNITS = {
@@ -27,6 +27,7 @@ HISTORY_UNITS = {
     "elastic": "J",
     "plastic_dissipation": "J",
     "viscous_dissipation": "J",
+    "coupling_work": "J",
     "contact_work": "J",
     "contact_force": "N",
     "dt": "s",
@@ -34,36 +35,47 @@ HISTORY_UNITS = {
 
 
 class TaylorRecorder:
-    """Listener of the run: the history (and its CSV), the balance, field frames, progress."""
+    """Listener of the run: the history (and its CSV), the balance, field frames, progress.
 
-    def __init__(self, model, con_name, weights, axis_top, face, ke0, folder, frame_times,
-                 progress) -> None:  # fmt: skip
-        self.model, self.con_name, self.weights = model, con_name, weights
-        self.axis_top, self.face = axis_top, face
+    Parameters
+    ----------
+    bar : MonoBar or ArlequinBar
+        The view of the models (:mod:`arlequin.demos.taylor_models`): ``measures(u)``,
+        ``energies(integ)``, ``series_meshes()``, ``frame(integ)``.
+    con_name : str
+        The wall constraint's name.
+    weights : ndarray
+        Collocation weights of the wall's surface (m²).
+    ke0 : float
+        KE_0 (J).
+    folder : ResultsFolder or None
+    frame_times : ndarray
+        Times of the field frames (s).
+    progress : callable or None
+        ``progress(t)`` at every record.
+    """
+
+    def __init__(self, bar, con_name, weights, ke0, folder, frame_times, progress) -> None:
+        self.bar, self.con_name, self.weights = bar, con_name, weights
         self.ke0 = ke0
         self.history: dict[str, list[float]] = {k: [] for k in HISTORY_UNITS}
         self.balance: list[float] = []
         self.csv = folder.history([*HISTORY_UNITS, "balance_error"],
                                   {**HISTORY_UNITS, "balance_error": "1"}) if folder else None
-        self.series = folder.series("bar", model.mesh) if folder else None
+        self.series = ({name: folder.series(name, mesh)
+                        for name, mesh in bar.series_meshes().items()} if folder else {})
         self.frame_times = np.asarray(frame_times) if folder else np.zeros(0)
         self._next_frame = 0
         self.progress = progress
         self.loop_start: float | None = None  # perf_counter at the initial record
         self._last: tuple[float, float] | None = None  # (t, accumulated wall impulse N·s)
-        dofs = model.nodal_dofs()
-        self._r, self._z = dofs[0], dofs[1]
 
     def __call__(self, integ) -> None:
         if self.loop_start is None:
             self.loop_start = time.perf_counter()
-        model, u = self.model, integ.u
-        state = integ.states["bar"][0]
-        x = model.current_coordinates(u)
+        length, radius = self.bar.measures(integ.u)
         kinetic = float(sum(integ.energies()["kinetic"].values()))
-        elastic = model.stored_energy(u, state)
-        dp = model.plastic_dissipation(state)
-        dv = model.viscous_dissipation(state)
+        parts = self.bar.energies(integ)
         cstate = integ.constraint_states[self.con_name]
         wc = -float(cstate.work)
         # λ is the nominal pressure (Pa) at the collocation points (≤ 0 in compression): the
@@ -78,59 +90,85 @@ class TaylorRecorder:
         self._last = (float(integ.t), impulse)
         row = {
             "t": float(integ.t),
-            "length": float(x[1, self.axis_top]),
-            "radius": float(x[0, self.face].max()),
+            "length": length,
+            "radius": radius,
             "kinetic": kinetic,
-            "elastic": elastic,
-            "plastic_dissipation": dp,
-            "viscous_dissipation": dv,
+            **parts,
             "contact_work": wc,
             "contact_force": force,
             "dt": float(integ.step_size or 0.0),
         }
-        err = abs(kinetic + elastic + dp + dv + wc - self.ke0) / self.ke0
+        # KE + W_el + D_p + D_visc + W_c = KE_0 + W_coupling (the net work of the coupling
+        # forces: zero for a mediator enforced exactly, kept to show it)
+        err = abs(kinetic + parts["elastic"] + parts["plastic_dissipation"]
+                  + parts["viscous_dissipation"] + wc - parts["coupling_work"]
+                  - self.ke0) / self.ke0  # fmt: skip
         self.balance.append(err)
-        for k, v in row.items():
-            self.history[k].append(v)
+        for k in HISTORY_UNITS:
+            self.history[k].append(row[k])
         if self.csv is not None:
             self.csv.append({**row, "balance_error": err})
         while self._next_frame < self.frame_times.size and (
             integ.t >= self.frame_times[self._next_frame] - 1e-12
         ):
             self._next_frame += 1
-            self.write_frame(integ.t, u, integ.v, state)
+            for name, (point, cell) in self.bar.frame(integ).items():
+                self.series[name].write(float(integ.t), point, cell)
         if self.progress is not None:
             self.progress(float(integ.t))
 
-    def write_frame(self, t, u, v, state) -> None:
-        n = self.model.mesh.nvertices
-        pad = np.zeros(n)
-        point = {
-            "displacement": np.column_stack([u[self._r], u[self._z], pad]),
-            "velocity": np.column_stack([v[self._r], v[self._z], pad]),
-        }
-        cell = {
-            "plastic_strain": state.eqps.mean(axis=1),
-            "von_mises": state.von_mises.mean(axis=1),
-        }
-        self.series.write(float(t), point, cell)
+
+class MultiplierHistory:
+    """Per-step multipliers of one mediator (an ``on_step`` listener), for the chatter check.
+
+    ``chatter()`` is max over the steps n and rows k of
+    |λ_n,k − (λ_{n−1},k + λ_{n+1},k)/2| / max_{n,k} |λ_n,k|: the step-to-step oscillation of the
+    multiplier history against its largest value (the Arlequin Taylor bar's criterion ≤ 0.05).
+    """
+
+    def __init__(self, name: str) -> None:
+        self.name = name
+        self._rows: list[np.ndarray] = []
+
+    def __call__(self, integ) -> None:
+        lam = integ.multipliers.get(self.name)
+        if lam is not None:
+            self._rows.append(np.asarray(lam, dtype=np.float32).copy())
+
+    def array(self) -> np.ndarray:
+        """(n_steps, n_rows) multipliers, one row per step."""
+        return np.vstack(self._rows) if self._rows else np.zeros((0, 0), dtype=np.float32)
+
+    def chatter(self) -> dict[str, float]:
+        """``{"global": ..., "per_row": ...}``: the oscillation against the largest multiplier
+        of all rows, and the largest over the rows of the oscillation of a row against that
+        row's own largest value (rows above 1% of the global largest only)."""
+        lam = self.array().astype(float)
+        if lam.shape[0] < 3:
+            return {"global": 0.0, "per_row": 0.0}
+        osc = np.abs(lam[1:-1] - 0.5 * (lam[:-2] + lam[2:])).max(axis=0)
+        peak = np.abs(lam).max(axis=0)
+        top = float(peak.max())
+        if top == 0.0:
+            return {"global": 0.0, "per_row": 0.0}
+        big = peak > 0.01 * top
+        return {"global": float(osc.max() / top), "per_row": float((osc[big] / peak[big]).max())}
 
 
 def write_results(folder: ResultsFolder, result: Any, units: dict[str, str]) -> None:
     """The scalar results (with ``units``), the pictures and the final results.json."""
     from .plots import plot_taylor_bar
-    from .render import render_taylor_bar
 
     values = {k: v for k, v in result.to_json().items()
               if k not in ("history", "config", "reference")}  # fmt: skip
     hist = result.history
     values["final_energies"] = {k: hist[k][-1] for k in ("kinetic", "elastic",
-                                "plastic_dissipation", "viscous_dissipation", "contact_work")}
+                                "plastic_dissipation", "viscous_dissipation", "coupling_work",
+                                "contact_work") if k in hist}
     folder.add_results(values, units)
     plot_taylor_bar(result, str(folder.picture("taylor_bar_history")))
     title = (f"t = {result.history['t'][-1] * 1e6:.1f} us: length {result.final_length * 1e3:.2f} "
-             f"mm, footprint radius {result.mushroom_radius * 1e3:.2f} mm "
-             f"(grey: initial shape)")  # fmt: skip
-    render_taylor_bar(result.model, result.u, result.state, str(folder.picture("taylor_bar")),
-                      title)  # fmt: skip
+             f"mm, footprint radius {result.mushroom_radius * 1e3:.2f} mm"
+             + ("" if result.arlequin else " (grey: initial shape)"))  # fmt: skip
+    result.setup.render(result.u, result.state, str(folder.picture("taylor_bar")), title)
     folder.finish()

@@ -74,6 +74,7 @@ def solve(
     record_every: int = 1,
     save_fields: bool = False,
     on_record: Sequence[Callable[[Integrator], None]] = (),
+    on_step: Sequence[Callable[[Integrator], None]] = (),
     **options: Any,
 ) -> DynamicResult:
     """Integrate a coupled system in time.
@@ -111,6 +112,9 @@ def solve(
         Also record u and v (memory: n_rec × n each).
     on_record : sequence of callables
         ``listener(integrator)`` after each record, before ``callback`` (results writers).
+    on_step : sequence of callables
+        ``listener(integrator)`` after every step, before any record of that step (cheap
+        per-step monitors, e.g. a multiplier history; they must not change the integrator).
     **options
         Passed to the integrator class (``beta``, ``gamma``, ``alpha``, ``theta``, ``safety``,
         ``constraints``, ``consistent_initial``...).
@@ -180,6 +184,8 @@ def solve(
             err.result = rec.result(-1, str(err))
             raise
         k += 1
+        for listener in on_step:
+            listener(integ)
         last = integ.status == "finished" or (n_steps is not None and k == n_steps)
         if pending is not None:
             take = bool(pending) and integ.t >= pending[0] - 1e-12 * float(integ.step_size)

@@ -1,0 +1,66 @@
+"""What the commands of the ``arlequin`` CLI share: the results check, JSON output, ``--out``."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+
+__all__ = ["NonFiniteResult", "add_out", "check_writable", "write_json"]
+
+
+class NonFiniteResult(RuntimeError):
+    """A command computed a NaN or an infinite value (the run is reported as failed)."""
+
+
+def _non_finite(data, prefix: str = "") -> list[str]:
+    """Keys of non-finite numbers in a JSON-like document."""
+    out: list[str] = []
+    if isinstance(data, dict):
+        for k, v in data.items():
+            out += _non_finite(v, f"{prefix}{k}.")
+    elif isinstance(data, (list, tuple)):
+        for i, v in enumerate(data):
+            out += _non_finite(v, f"{prefix}{i}.")
+    elif isinstance(data, float) and not math.isfinite(data):
+        out.append(f"{prefix[:-1]}={data}")
+    elif isinstance(data, str) and data in ("nan", "inf", "-inf"):
+        out.append(f"{prefix[:-1]}={data}")
+    return out
+
+
+def _check_results(data: dict) -> None:
+    bad = _non_finite(data)
+    if bad:
+        shown = ", ".join(bad[:5]) + (f" and {len(bad) - 5} more" if len(bad) > 5 else "")
+        raise NonFiniteResult(f"the run produced non-finite results: {shown}")
+
+
+def write_json(path: str | None, data: dict) -> None:
+    """Write ``data`` as JSON to ``path`` (if given) after refusing non-finite values."""
+    _check_results(data)
+    if path:
+        with open(path, "w", encoding="utf-8") as fh:
+            json.dump(data, fh, indent=2)
+
+
+def check_writable(path: str | None, option: str) -> None:
+    """Refuse, before any computation, an output file whose folder cannot be written."""
+    if not path:
+        return
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder) or not os.access(folder, os.W_OK):
+        raise ValueError(
+            f"{option} {path!r}: the folder {folder!r} does not exist or is not writable"
+        )
+
+
+def add_out(p: argparse.ArgumentParser) -> None:
+    """The ``--out DIR`` option of the demos."""
+    p.add_argument(
+        "--out",
+        metavar="DIR",
+        default=None,
+        help="write a results folder: results.json, history.csv, fields/*.xdmf, pictures",
+    )

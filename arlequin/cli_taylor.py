@@ -1,0 +1,269 @@
+"""The ``arlequin taylor-bar`` command: options, progress bar, summary and JSON.
+
+A thin layer over :func:`arlequin.demos.taylor_bar.run_taylor_bar` (SI units).
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from .cli_common import add_out, write_json
+
+__all__ = ["add_taylor_bar"]
+
+
+class _LazyBar:
+    """A tqdm bar over the simulated time (µs) with ETA on stderr, opened at the first update
+    (so that input errors, raised before any work, print no bar)."""
+
+    def __init__(self, total: float) -> None:
+        self.total = total
+        self.bar = None
+
+    def update(self, t: float) -> None:
+        if self.bar is None:
+            from tqdm import tqdm
+
+            self.bar = tqdm(
+                total=round(self.total * 1e6, 3),
+                unit="µs",
+                desc="simulated time",
+                leave=False,
+                bar_format="{l_bar}{bar}| {n:.1f}/{total:.1f} µs [{elapsed}<{remaining}]",
+            )
+        self.bar.n = round(t * 1e6, 3)
+        self.bar.refresh()
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+
+
+def _progress_bar(total: float, quiet: bool):
+    """(bar, update): a lazily opened progress bar and its update, or (None, None) when quiet."""
+    if quiet:
+        return None, None
+    bar = _LazyBar(total)
+    return bar, bar.update
+
+
+def _cmd_taylor_bar(args: argparse.Namespace) -> int:
+    from .demos.taylor_bar import run_taylor_bar
+
+    law_params = {
+        k: getattr(args, k)
+        for k in ("voce_saturation", "voce_rate", "jc_b", "jc_n", "jc_c", "jc_reference_rate")
+    }
+    law_params = {k: v for k, v in law_params.items() if v is not None}
+    bar, update = _progress_bar(args.t_end, args.quiet)
+    arlequin = {}
+    if args.model == "arlequin":
+        arlequin = {
+            "patch_length": args.patch_length, "gluing_width": args.gluing_width,
+            "coarse_size": args.coarse_size, "fine_size": args.fine_size,
+            "weights": args.weights, "mediator": args.mediator, "coupling": args.coupling,
+            "coarse_step_ratio": args.coarse_step_ratio, "band_warning": args.band_warning,
+        }  # fmt: skip
+    else:
+        given = [f"--{k.replace('_', '-')}" for k in ("patch_length", "gluing_width",
+                 "coarse_size", "fine_size") if getattr(args, k) is not None]  # fmt: skip
+        if given:
+            raise ValueError(f"{', '.join(given)} apply to --model arlequin only")
+    try:
+        result = run_taylor_bar(
+            model=args.model,
+            elements_radial=args.elements_radial,
+            mesh_size=args.mesh_size,
+            t_end=args.t_end,
+            velocity=args.velocity,
+            young=args.young,
+            poisson=args.poisson,
+            density=args.density,
+            yield_stress=args.yield_stress,
+            hardening=args.hardening,
+            hardening_law=args.hardening_law,
+            length=args.length,
+            radius=args.radius,
+            bulk_viscosity=args.bulk_viscosity,
+            fbar=not args.no_fbar,
+            backend=args.backend,
+            out=args.out,
+            progress=update,
+            **arlequin,
+            **law_params,
+        )
+    finally:
+        if bar is not None:
+            bar.close()
+    print(result.summary())
+    write_json(args.json, result.to_json())
+    return 0
+
+
+def add_taylor_bar(sub) -> None:
+    """Register ``arlequin taylor-bar`` on the subcommand parsers ``sub``."""
+    p = sub.add_parser(
+        "taylor-bar",
+        help="Taylor bar impact: a copper bar hits a rigid wall (Arlequin: a coarse elastic bar "
+        "plus a refined finite-strain J2 patch; or one mesh)",
+        description="A bar (length L, radius R) moving at V hits a rigid frictionless wall at "
+        "t = 0. Default (--model arlequin): a coarse linear-elastic model of the whole bar and a "
+        "refined finite-strain J2 patch over the impacted end, glued by a mediator in a band at "
+        "the patch's top; --model mono: one finite-strain mesh. Axisymmetric Q1 F-bar cells, "
+        "central differences with the step re-estimated in the current configuration, the "
+        "level-set contact model at the wall (on the patch). SI units; lengths in m, element "
+        "edges in the reference configuration. "
+        "Reports the final length, the footprint (mushroom) radius, the maximum equivalent "
+        "plastic strain and the energy balance error (a fraction).",
+    )
+    p.add_argument(
+        "--model",
+        choices=["arlequin", "mono"],
+        default="arlequin",
+        help="arlequin: coarse elastic bar + refined elastoplastic patch; mono: one "
+        "finite-strain mesh over the whole bar",
+    )
+    size = p.add_mutually_exclusive_group()
+    size.add_argument(
+        "--elements-radial",
+        type=int,
+        default=None,
+        metavar="N",
+        help="cells across the radius (default 10; arlequin: of the patch); the axial count "
+        "is round(L/h)",
+    )
+    size.add_argument(
+        "--mesh-size",
+        type=float,
+        default=None,
+        metavar="H",
+        help="cell edge across the radius (m; arlequin: an alias of --fine-size)",
+    )
+    size.add_argument(
+        "--fine-size",
+        type=float,
+        default=None,
+        metavar="H",
+        help="arlequin: the patch's cell edge (m; default R/10)",
+    )
+    p.add_argument(
+        "--coarse-size",
+        type=float,
+        default=None,
+        metavar="H",
+        help="arlequin: the coarse cell edge (m), a multiple of the fine size (default 2x)",
+    )
+    p.add_argument(
+        "--patch-length",
+        type=float,
+        default=None,
+        metavar="LP",
+        help="arlequin: patch length from the impact face (m, default 0.9 L; whole coarse rows)",
+    )
+    p.add_argument(
+        "--gluing-width",
+        type=float,
+        default=None,
+        metavar="W",
+        help="arlequin: gluing band width at the patch's top (m, default 2 coarse rows)",
+    )
+    p.add_argument("--weights", choices=["ramp", "constant"], default="ramp",
+                   help="arlequin: partition weights across the band")  # fmt: skip
+    p.add_argument("--mediator", choices=["coarse", "fine"], default="fine",
+                   help="arlequin: mediator space")  # fmt: skip
+    p.add_argument("--coupling", choices=["L2", "H1"], default="H1",
+                   help="arlequin: coupling operator")  # fmt: skip
+    p.add_argument(
+        "--coarse-step-ratio",
+        type=int,
+        default=1,
+        metavar="M",
+        help="arlequin: coarse steps per patch step (only 1 is implemented so far)",
+    )
+    p.add_argument(
+        "--band-warning",
+        type=float,
+        default=0.02,
+        metavar="EPS",
+        help="arlequin: warn if the plastic strain in the gluing band exceeds this",
+    )
+    p.add_argument("--t-end", type=float, default=80e-6, metavar="T", help="end time (s)")
+    p.add_argument("--velocity", type=float, default=227.0, metavar="V", help="impact speed (m/s)")
+    p.add_argument("--young", type=float, default=117e9, metavar="E", help="Young's modulus (Pa)")
+    p.add_argument("--poisson", type=float, default=0.35, metavar="NU", help="Poisson's ratio")
+    p.add_argument("--density", type=float, default=8930.0, metavar="RHO", help="density (kg/m^3)")
+    p.add_argument(
+        "--yield-stress", type=float, default=0.4e9, metavar="S", help="initial yield stress (Pa)"
+    )
+    p.add_argument(
+        "--hardening",
+        type=float,
+        default=0.1e9,
+        metavar="H",
+        help="linear hardening modulus (Pa; the linear term of the Voce law)",
+    )
+    p.add_argument("--hardening-law", choices=["linear", "voce", "johnson-cook"], default="linear")
+    p.add_argument(
+        "--voce-saturation",
+        type=float,
+        default=None,
+        metavar="Q",
+        help="Voce: saturation stress Q (Pa, default 0.1e9)",
+    )
+    p.add_argument(
+        "--voce-rate",
+        type=float,
+        default=None,
+        metavar="B",
+        help="Voce: saturation rate b (default 10)",
+    )
+    p.add_argument(
+        "--jc-b",
+        type=float,
+        default=None,
+        metavar="B",
+        help="Johnson-Cook: B (Pa, default 0.292e9; A is --yield-stress)",
+    )
+    p.add_argument(
+        "--jc-n",
+        type=float,
+        default=None,
+        metavar="N",
+        help="Johnson-Cook: exponent n (default 0.31)",
+    )
+    p.add_argument(
+        "--jc-c",
+        type=float,
+        default=None,
+        metavar="C",
+        help="Johnson-Cook: strain-rate coefficient C (default 0: off)",
+    )
+    p.add_argument(
+        "--jc-reference-rate",
+        type=float,
+        default=None,
+        metavar="R",
+        help="Johnson-Cook: reference strain rate (1/s, default 1)",
+    )
+    p.add_argument("--length", type=float, default=32.4e-3, metavar="L", help="bar length (m)")
+    p.add_argument("--radius", type=float, default=3.2e-3, metavar="R", help="bar radius (m)")
+    p.add_argument(
+        "--bulk-viscosity",
+        action="store_true",
+        help="artificial bulk viscosity (linear 0.06, quadratic 1.5)",
+    )
+    p.add_argument(
+        "--no-fbar",
+        action="store_true",
+        help="plain Q1 cells (they lock under plastic flow; for comparison)",
+    )
+    p.add_argument(
+        "--backend",
+        choices=["auto", "numba", "numpy"],
+        default="auto",
+        help="internal-force path (auto: the compiled kernel)",
+    )
+    p.add_argument("--json", metavar="PATH", default=None, help="write the results as JSON")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_out(p)
+    p.set_defaults(func=_cmd_taylor_bar)
