@@ -57,7 +57,10 @@ def _cmd_taylor_bar(args: argparse.Namespace) -> int:
     law_params = {k: v for k, v in law_params.items() if v is not None}
     bar, update = _progress_bar(args.t_end, args.quiet)
     arlequin = {}
-    if args.model == "arlequin":
+    if args.model == "graded":
+        arlequin = {k: getattr(args, k) for k in ("patch_length", "coarse_size", "fine_size")}
+        arlequin = {k: v for k, v in arlequin.items() if v is not None}
+    elif args.model == "arlequin":
         arlequin = {
             "patch_length": args.patch_length, "gluing_width": args.gluing_width,
             "coarse_size": args.coarse_size, "fine_size": args.fine_size,
@@ -68,7 +71,7 @@ def _cmd_taylor_bar(args: argparse.Namespace) -> int:
         given = [f"--{k.replace('_', '-')}" for k in ("patch_length", "gluing_width",
                  "coarse_size", "fine_size") if getattr(args, k) is not None]  # fmt: skip
         if given:
-            raise ValueError(f"{', '.join(given)} apply to --model arlequin only")
+            raise ValueError(f"{', '.join(given)} apply to --model arlequin or graded only")
     try:
         result = run_taylor_bar(
             model=args.model,
@@ -118,10 +121,11 @@ def add_taylor_bar(sub) -> None:
     )
     p.add_argument(
         "--model",
-        choices=["arlequin", "mono"],
+        choices=["arlequin", "mono", "graded"],
         default="arlequin",
-        help="arlequin: coarse elastic bar + refined elastoplastic patch; mono: one "
-        "finite-strain mesh over the whole bar",
+        help="arlequin: coarse elastic bar + refined elastoplastic patch; mono: one uniform "
+        "finite-strain mesh; graded: one conforming mesh, fine over the patch region, coarse "
+        "above, a 2:1 transition row",
     )
     size = p.add_mutually_exclusive_group()
     size.add_argument(

@@ -67,10 +67,18 @@ class ArlequinProblem:
         The model of the whole structure.
     patches : sequence of Patch
         Non-overlapping refined patches.
+    mediator_dirichlet : {"keep", "drop"}
+        ``"drop"``: remove the mediator functions carried by dofs that a Dirichlet condition of
+        the carrier model (the coarse one for a coarse mediator, the patch for a fine one)
+        prescribes, so that the multiplier space is the trace of the constrained spaces. Use it
+        when both models carry the same condition in the gluing zone (a symmetry axis through
+        the band): the rows would otherwise repeat the conditions (exactly so with a fine
+        mediator: linearly dependent rows) and carry their reactions. Default ``"keep"``.
     """
 
     coarse: Any
     patches: Sequence[Patch] = field(default_factory=list)
+    mediator_dirichlet: str = "keep"
 
     def __post_init__(self) -> None:
         check_protocol(self.coarse, Model, "the coarse model")
@@ -88,6 +96,10 @@ class ArlequinProblem:
         if len(set(self._names)) != len(self._names):
             raise ValueError(f"block names must be unique, got {self._names}")
         self._check_patches_disjoint()
+        if self.mediator_dirichlet not in ("keep", "drop"):
+            raise ValueError(
+                f"mediator_dirichlet must be 'keep' or 'drop', got {self.mediator_dirichlet!r}"
+            )
 
     # ------------------------------------------------------------------ set-up
     @property
@@ -290,6 +302,7 @@ class ArlequinProblem:
         for pc in couplings:
             cm = pc.coupling
             rows = dofmap.embed("coarse", cm.coarse) - dofmap.embed(pc.name, cm.fine)
+            rows = rows.tocsr()[np.nonzero(self.mediator_rows(pc))[0]]
             constraints.append(
                 LinearConstraint(rows.tocsr(), None, f"coupling:{pc.name}", kind="coupling")
             )
@@ -331,7 +344,8 @@ class ArlequinProblem:
                 BlockFields(pc.name, pc.fine_model.mesh, pc.n_components, {"alpha": alpha})
             )
             carrier = "coarse" if pc.coupling.mediator == "coarse" else pc.name
-            multipliers[f"coupling:{pc.name}"] = (carrier, pc.coupling.mediator_dofs)
+            keep = self.mediator_rows(pc)
+            multipliers[f"coupling:{pc.name}"] = (carrier, pc.coupling.mediator_dofs[keep])
         coarse = BlockFields(
             "coarse",
             self.coarse.mesh,
@@ -339,6 +353,25 @@ class ArlequinProblem:
             {"alpha": 1.0 - fine_share / c_measure},
         )
         return FieldLayout([coarse, *blocks], multipliers)
+
+    def mediator_rows(self, pc: PatchCoupling) -> np.ndarray:
+        """Boolean mask of the mediator functions of ``pc`` kept as coupling rows (all of them,
+        unless ``mediator_dirichlet="drop"``)."""
+        dofs = np.asarray(pc.coupling.mediator_dofs)
+        if self.mediator_dirichlet == "keep":
+            return np.ones(dofs.size, dtype=bool)
+        carrier = "coarse" if pc.coupling.mediator == "coarse" else pc.name
+        model = self.model(carrier)
+        d = int(model.n_components)
+        fixed = np.zeros(int(model.n_dofs), dtype=bool)
+        for bc in self._dirichlet:
+            if bc.block != carrier or bc.level != "displacement":
+                continue
+            nodes = np.nonzero(np.asarray(bc.where(model.mesh.p), dtype=bool))[0]
+            comps = range(d) if bc.components is None else bc.components
+            for c in comps:
+                fixed[d * nodes + c] = True
+        return ~fixed[dofs]
 
     def dofmap(self) -> DofMap:
         """The dof layout of the coupled system: the coarse block, then one block per patch."""

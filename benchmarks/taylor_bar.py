@@ -9,7 +9,15 @@ compilation and the integrator's set-up excluded), peak resident memory, the rat
 results (final length, footprint radius, maximum ε̄p, energy balance error) against the published
 values. ``--plain`` levels also run without F-bar (the locking comparison).
 
+``--compare N`` instead runs, in one process and at N fine cells across the radius, the
+Arlequin bar (defaults: patch 0.9 L, fine mediator, H1, ramp), the uniform single mesh at the
+patch's resolution (``--model mono --mesh-size R/N``) and the graded single mesh (``--model
+graded``), and prints their wall times, the ratios T_arlequin / T_uniform against the bound
+(1 + p)/2 with p the patch's share of the fine cells and T_arlequin / T_graded against 1.3, the
+three quantities of interest of each and the process's peak memory after each run.
+
     python benchmarks/taylor_bar.py [--levels 5 10 20 30] [--plain 10 20] [--window 1e-6]
+    python benchmarks/taylor_bar.py --compare 20
 """
 
 from __future__ import annotations
@@ -58,6 +66,55 @@ def one_level(n: int, fbar: bool, window: float) -> dict:
     return record
 
 
+def _qoi(r) -> dict:
+    return {
+        "elements": r.n_elements,
+        "steps": r.n_steps,
+        "wall_time_s": round(r.wall_time_s, 2),
+        "final_length_mm": round(r.final_length * 1e3, 4),
+        "mushroom_radius_mm": round(r.mushroom_radius * 1e3, 4),
+        "max_plastic_strain": round(r.max_plastic_strain, 4),
+        "energy_balance_error": float(f"{r.energy_balance_error:.3g}"),
+        "peak_rss_mib_after": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, 1),
+    }
+
+
+def compare(n: int) -> dict:
+    """Arlequin against the uniform fine mesh, in this process (see the module docstring)."""
+    import warnings
+
+    from arlequin.demos.taylor_bar import GluingBandPlasticityWarning, run_taylor_bar
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", GluingBandPlasticityWarning)
+        arl = run_taylor_bar(model="arlequin", elements_radial=n)
+    uni = run_taylor_bar(model="mono", elements_radial=n)
+    graded = run_taylor_bar(model="graded", elements_radial=n)
+    a = arl.arlequin
+    p = a["patch_fraction"]
+    ratio = arl.wall_time_s / uni.wall_time_s
+    out = {
+        "fine_cells_across": n,
+        "patch_fraction": round(p, 4),
+        "arlequin": {**_qoi(arl), **{k: a[k] for k in ("coarse_elements", "fine_elements",
+                     "band_max_plastic_strain", "multiplier_chatter_per_row")},
+                     "band_warning": bool(caught)},
+        "uniform": _qoi(uni),
+        "graded": _qoi(graded),
+        "time_ratio_arlequin_uniform": round(ratio, 4),
+        "time_bound_(1+p)/2": round((1 + p) / 2, 4),
+        "time_ratio_arlequin_graded": round(arl.wall_time_s / graded.wall_time_s, 4),
+        "time_bound_graded": 1.3,
+        "graded_length_difference": round(graded.final_length / uni.final_length - 1, 5),
+        "graded_radius_difference": round(graded.mushroom_radius / uni.mushroom_radius - 1, 5),
+        "length_difference": round(arl.final_length / uni.final_length - 1, 5),
+        "radius_difference": round(arl.mushroom_radius / uni.mushroom_radius - 1, 5),
+        "max_plastic_strain_difference": round(arl.max_plastic_strain / uni.max_plastic_strain
+                                               - 1, 5),
+    }  # fmt: skip
+    return out
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--levels", type=int, nargs="+", default=[5, 10, 20, 30])
@@ -65,9 +122,17 @@ def main(argv: list[str] | None = None) -> int:
                         help="levels also run without F-bar")  # fmt: skip
     parser.add_argument("--window", type=float, default=1e-6,
                         help="simulated time (s) of the numpy/numba comparison")  # fmt: skip
+    parser.add_argument("--compare", type=int, default=None, metavar="N",
+                        help="Arlequin vs the uniform mesh, N fine cells across")  # fmt: skip
     parser.add_argument("--single", type=int, default=None, help=argparse.SUPPRESS)
     parser.add_argument("--no-fbar", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
+    if args.compare is not None:
+        from arlequin.models.j2_kernel import warm_up
+
+        warm_up()
+        print(json.dumps({"benchmark": "taylor_bar_compare", **compare(args.compare)}, indent=2))
+        return 0
     if args.single is not None:
         print(json.dumps(one_level(args.single, not args.no_fbar, args.window)))
         return 0

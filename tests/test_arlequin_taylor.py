@@ -28,7 +28,8 @@ from arlequin.demos.taylor_bar import (
     GluingBandPlasticityWarning,
     run_taylor_bar,
 )
-from arlequin.demos.taylor_models import ArlequinBar, arlequin_bar_sizes
+from arlequin.demos.taylor_meshes import arlequin_bar_sizes
+from arlequin.demos.taylor_models import ArlequinBar
 from arlequin.io import read_series
 from arlequin.models import J2Material, make_hardening
 from arlequin.weights import RampWeights
@@ -67,7 +68,7 @@ def test_bad_sizes_are_refused(kwargs, match):
 @pytest.mark.parametrize(
     ("kwargs", "match"),
     [
-        ({"model": "mono", "patch_length": 0.01}, "apply to model='arlequin' only"),
+        ({"model": "mono", "patch_length": 0.01}, "apply to model='arlequin' or 'graded' only"),
         ({"model": "mono", "fine_size": 0.3e-3}, "fine_size applies to model='arlequin'"),
         ({"fine_size": 0.32e-3, "mesh_size": 0.32e-3}, "give one of"),
         ({"weights": "linear"}, "weights must be 'ramp', 'constant'"),
@@ -182,3 +183,63 @@ def test_arlequin_matches_the_single_mesh_run():
     assert arl.arlequin["multiplier_chatter_per_row"] <= 0.05
     # the band's plastic strain is that of the single mesh at the same place (0.0106 there)
     assert arl.arlequin["band_max_plastic_strain"] < 0.02
+
+
+# ------------------------------------------------------------------ the graded single mesh
+@pytest.mark.parametrize("fine", [10, 20])  # 5 coarse columns (odd: a split outer column), 10
+def test_graded_mesh_is_conforming_and_covers_the_bar(fine):
+    import skfem
+
+    from arlequin.demos.taylor_meshes import graded_bar_mesh
+    from arlequin.meshcheck import check_mesh
+
+    s = arlequin_bar_sizes(L, R, fine)
+    mesh = graded_bar_mesh(L, R, s)
+    check_mesh(mesh, "graded")  # no folded, degenerate or duplicate cell, no unused node
+    area = skfem.Basis(mesh, skfem.ElementQuad1()).dx.sum()
+    assert area == pytest.approx(R * L, rel=1e-13)
+    # a hanging node would leave unmatched interior facets on the "boundary": count them
+    columns_above = s.coarse_radial + (s.coarse_radial % 2)
+    rows_side = 2 * s.patch_rows + 1 + (s.coarse_axial - s.patch_rows - 1)
+    assert mesh.boundary_facets().size == fine + columns_above + 2 * rows_side
+    # fine cells over the patch region, 2:1 templates (6 quads per 2 coarse columns) above it
+    n_fine = fine * 2 * s.patch_rows
+    n_transition = 6 * (s.coarse_radial // 2) + 2 * (s.coarse_radial % 2)
+    assert mesh.nelements == n_fine + n_transition + columns_above * (s.coarse_axial
+                                                                       - s.patch_rows - 1)
+
+
+def test_graded_mesh_needs_a_ratio_of_two():
+    from arlequin.demos.taylor_meshes import graded_bar_mesh
+
+    with pytest.raises(ValueError, match="ratio 2"):
+        graded_bar_mesh(L, R, arlequin_bar_sizes(L, R, 12, coarse_size=R / 3))
+
+
+def test_mediator_rows_on_the_axis_are_dropped():
+    law = make_hardening("linear", yield_stress=0.4e9, modulus=0.1e9)
+    material = J2Material.with_law(117e9, 0.35, 8930.0, law)
+    for mediator in ("fine", "coarse"):
+        bar = ArlequinBar(L, R, arlequin_bar_sizes(L, R, 4), material, mediator=mediator)
+        pc = bar.coupling
+        keep = bar.problem.mediator_rows(pc)
+        carrier = bar.fine_mesh if mediator == "fine" else bar.coarse_mesh
+        dofs = pc.coupling.mediator_dofs
+        on_axis_r = (dofs % 2 == 0) & (carrier.p[0, dofs // 2] < 1e-12)
+        assert on_axis_r.any() and np.array_equal(keep, ~on_axis_r)
+        rows = next(c for c in bar.system.constraints if c.kind == "coupling")
+        assert rows.n_rows == int(keep.sum())
+    with pytest.raises(ValueError, match="mediator_dirichlet must be"):
+        from arlequin import ArlequinProblem
+
+        ArlequinProblem(bar.coarse, [], mediator_dirichlet="sometimes")
+
+
+@pytest.mark.slow
+def test_graded_mesh_matches_the_uniform_run():
+    # the conforming graded mesh keeps the fine size where the bar flows: the same answer
+    graded = run_taylor_bar(model="graded", elements_radial=10)
+    mono = run_taylor_bar(model="mono", elements_radial=10)
+    assert graded.final_length == pytest.approx(mono.final_length, rel=0.01)
+    assert graded.mushroom_radius == pytest.approx(mono.mushroom_radius, rel=0.01)
+    assert graded.energy_balance_error <= 0.01

@@ -24,3 +24,19 @@ def test_refined_patch_example(coupling):
     out = load("refined_patch").run(n=4, levels=1, coupling=coupling)
     assert out["relative_error"] <= 1e-10
     assert out["residual"] <= 1e-12
+
+
+def test_arlequin_taylor_bar_tutorial_is_the_demo():
+    # the tutorial builds with the public API what run_taylor_bar(model="arlequin") builds:
+    # the same steps and the same answer (to round-off)
+    import warnings
+
+    from arlequin.demos import run_taylor_bar
+
+    out = load("arlequin_taylor_bar").run(fine_radial=4, t_end=6e-6)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        demo = run_taylor_bar(elements_radial=4, t_end=6e-6)
+    assert out["n_steps"] == demo.n_steps
+    assert out["final_length"] == pytest.approx(demo.final_length, rel=1e-12)
+    assert out["mushroom_radius"] == pytest.approx(demo.mushroom_radius, rel=1e-12)

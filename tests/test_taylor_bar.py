@@ -47,7 +47,7 @@ def test_mesh_has_nearly_square_cells():
         ({"elements_radial": 4, "mesh_size": 1e-3}, "not both"),
         ({"mesh_size": 5e-3}, "must not exceed the radius"),
         ({"elements_radial": 2.5}, "elements_radial must be a positive integer"),
-        ({"model": "graded"}, "model must be one of"),
+        ({"model": "hybrid"}, "model must be one of"),
         ({"hardening_law": "swift"}, "hardening law must be one of"),
         ({"hardening_law": "voce", "jc_n": 0.3}, r"\['jc_n'\] do not belong to the voce law"),
         ({"poisson": 0.5}, "Poisson"),

@@ -126,6 +126,9 @@ def plot_taylor_bar(result: TaylorBarResult, path: str) -> None:
              ("viscous_dissipation", "bulk-viscosity dissipation"),
              ("contact_work", "removed by the wall")]  # fmt: skip
     total = sum(h[k] for k, _ in parts)
+    if "coupling_work" in h:  # Arlequin: the net work of the mediator's forces (zero if exact)
+        total = total - h["coupling_work"]
+        parts.append(("coupling_work", "coupling work"))
     for k, label in parts:
         if k == "viscous_dissipation" and not np.any(h[k]):
             continue
@@ -136,8 +139,9 @@ def plot_taylor_bar(result: TaylorBarResult, path: str) -> None:
     ax2.legend(fontsize=8)
     for ax in (ax1, ax2):
         ax.grid(alpha=0.3)
+    model = result.config.get("model", "mono")
     fig.suptitle(
-        f"Taylor bar, {result.elements_radial} x {result.elements_axial} cells: L = "
+        f"Taylor bar ({model}), {result.elements_radial} x {result.elements_axial} cells: L = "
         f"{result.final_length * 1e3:.2f} mm, R = {result.mushroom_radius * 1e3:.2f} mm, "
         f"max ε̄p = {result.max_plastic_strain:.2f}"
     )

@@ -1,8 +1,12 @@
-"""The Taylor bar impact on one mesh: finite-strain J2, explicit dynamics, the level-set wall.
+"""The Taylor bar impact: finite-strain J2, explicit dynamics, the level-set wall.
 
-A copper bar (length L, radius R, axisymmetric Q1 mesh, F-bar) moving at −v₀ along z touches a
+A copper bar (length L, radius R, axisymmetric Q1 F-bar cells) moving at −v₀ along z touches a
 rigid frictionless wall z = 0 at t = 0 (DESIGN §4: L = 32.4 mm, R = 3.2 mm, v₀ = 227 m/s,
-E = 117 GPa, ν = 0.35, ρ = 8930 kg/m³, σ_y0 = 0.4 GPa, H = 0.1 GPa, 80 µs). The wall is the
+E = 117 GPa, ν = 0.35, ρ = 8930 kg/m³, σ_y0 = 0.4 GPa, H = 0.1 GPa, 80 µs). Three models
+(:mod:`arlequin.demos.taylor_models`): ``arlequin`` (default) a coarse linear-elastic bar plus a
+refined finite-strain patch over the impacted end, glued by a mediator in a band at the patch's
+top (docs/arlequin_taylor.md); ``mono`` one uniform finite-strain mesh; ``graded`` one
+conforming finite-strain mesh, fine over the patch region and coarse above. The wall is the
 level-set contact model on the impact face and the lower lateral surface (which folds onto the
 wall as the mushroom forms), lift-off allowed; the axis carries u_r = 0. Central differences
 with the step re-estimated from the current configuration every few steps
@@ -15,12 +19,15 @@ the contact forces on the bar, the loss of stopping the impact face at t = 0 inc
 = ½ v₀·M v₀ with the lumped mass. Reported: the final length (axial position of the top-face
 node on the axis), the footprint (mushroom) radius (the largest distance from the axis of a
 node of the impact face), the maximum equivalent plastic strain and the balance error
-max_t |KE + W_el + D_p + D_visc + W_c − KE_0| / KE_0. SI units throughout.
+max_t |KE + W_el + D_p + D_visc + W_c − W_coupling − KE_0| / KE_0 (W_coupling, the net work of
+the mediator's forces, is zero on one mesh). SI units throughout.
 
 The run writes its results as it goes (``out=DIR``): results.json (inputs with units, then the
 results), history.csv (one row per record), fields/bar.xdmf (u, v, ε̄p and the von Mises
-stress on the reference mesh; warp by ``displacement`` in ParaView) and, at the end,
-taylor_bar.png (the final shape coloured by ε̄p) and taylor_bar_history.png.
+stress on the reference mesh; warp by ``displacement`` in ParaView; ``arlequin``:
+fields/coarse.xdmf and fields/patch.xdmf with the weights and the multipliers) and, at the end,
+taylor_bar.png (the final shape coloured by ε̄p; ``arlequin``: both models, initial and final)
+and taylor_bar_history.png.
 """
 
 from __future__ import annotations
@@ -39,7 +46,8 @@ from ..integrators import CriticalFraction, solve
 from ..io import ResultsFolder
 from ..models import HARDENING_LAWS, BulkViscosity, J2Material, make_hardening
 from ..weights import PartitionWeights
-from .taylor_models import ArlequinBar, MonoBar, arlequin_bar_sizes, taylor_bar_mesh
+from .taylor_meshes import arlequin_bar_sizes, graded_bar_mesh, taylor_bar_mesh
+from .taylor_models import ArlequinBar, MonoBar
 from .taylor_record import HISTORY_UNITS, MultiplierHistory, TaylorRecorder, write_results
 from .taylor_result import (
     ARLEQUIN_JSON_KEYS,
@@ -265,13 +273,16 @@ def run_taylor_bar(
                         ("frame_interval", frame_interval)]:  # fmt: skip
         _positive(name, value)
     arlequin = model == "arlequin"
-    if not arlequin:
+    nested = model in ("arlequin", "graded")  # the patch's sizes apply
+    if not nested:
         extra = {k: v for k, v in (("patch_length", patch_length), ("gluing_width", gluing_width),
                                    ("coarse_size", coarse_size)) if v is not None}  # fmt: skip
         if extra:
-            raise ValueError(f"{sorted(extra)} apply to model='arlequin' only, got model={model!r}")
+            raise ValueError(f"{sorted(extra)} apply to model='arlequin' or 'graded' only, got "
+                             f"model={model!r}")  # fmt: skip
         if fine_size is not None:
-            raise ValueError(f"fine_size applies to model='arlequin' only (use mesh_size), got "
+            raise ValueError(f"fine_size applies to model='arlequin' or 'graded' only (use "
+                             f"mesh_size), got "
                              f"model={model!r}")  # fmt: skip
         n_r = _elements_radial(elements_radial, mesh_size, radius)
     else:
@@ -308,14 +319,22 @@ def run_taylor_bar(
         raise ValueError(f"fbar must be True or False, got fbar={fbar!r}")
     visc = BulkViscosity() if bulk_viscosity is True else (bulk_viscosity or None)
     config: dict[str, Any] = {"model": model}
-    if arlequin:
+    if nested:
         sizes = arlequin_bar_sizes(length, radius, n_r, coarse_size, patch_length, gluing_width)
-        bar: MonoBar | ArlequinBar = ArlequinBar(
+        config.update(sizes.as_dict())
+    if model == "graded":
+        bar: MonoBar | ArlequinBar = MonoBar(
+            length, radius, n_r, material, fbar, backend, visc,
+            mesh=graded_bar_mesh(length, radius, sizes),
+        )  # fmt: skip
+        n_z = 2 * sizes.patch_rows
+    elif arlequin:
+        bar = ArlequinBar(
             length, radius, sizes, material, weights=weights, mediator=mediator,
             coupling=coupling, fbar=fbar, backend=backend, bulk_viscosity=visc,
         )  # fmt: skip
         n_z = sizes.patch_rows * sizes.ratio
-        config.update(sizes.as_dict(), weights=str(weights), mediator=mediator, coupling=coupling,
+        config.update(weights=str(weights), mediator=mediator, coupling=coupling,
                       coarse_step_ratio=int(coarse_step_ratio), band_warning=band_warning,
                       epsilon=1e-3)  # fmt: skip
     else:
@@ -397,6 +416,13 @@ def run_taylor_bar(
         state=state,
         setup=bar,
     )
+    if model == "graded":
+        fine_cells = 2 * sizes.coarse_radial * 2 * sizes.patch_rows
+        result.arlequin = {
+            "coarse_elements": bar.n_elements - fine_cells, "fine_elements": fine_cells,
+            "coarse_size": sizes.coarse_size, "fine_size": sizes.fine_size,
+            "patch_length": sizes.patch_length,
+        }  # fmt: skip
     if arlequin:
         assert isinstance(bar, ArlequinBar) and lam_history is not None
         s = bar.sizes

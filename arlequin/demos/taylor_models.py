@@ -15,6 +15,12 @@ glued), so the pictures draw the coarse cells above the band's lower edge only. 
 coarse cells instead would give the same answer up to O(ε) and save little: they are linear,
 a sparse product per step.
 
+Both models carry u_r = 0 on the axis, and so does the mediator space
+(``ArlequinProblem(..., mediator_dirichlet="drop")``): with the fine mediator, whose rows tie
+every patch dof of the band to the coarse field, the rows of u_r on the axis would repeat the
+axis conditions (linearly dependent rows), and with either mediator they would carry the axis
+reactions, which oscillate from step to step in an explicit run.
+
 Both classes give the recorder (:mod:`arlequin.demos.taylor_record`) the same view: the
 length and footprint radius of a displacement, the energies of the models, the field frames
 and the final picture. SI units.
@@ -22,8 +28,6 @@ and the final picture. SI units.
 
 from __future__ import annotations
 
-import dataclasses
-import math
 from typing import Any
 
 import numpy as np
@@ -41,21 +45,13 @@ from ..models import (
 )
 from ..problem import ArlequinProblem, Patch
 from ..system import Block, BlockTerm, CoupledSystem, LinearConstraint
+from .taylor_meshes import ArlequinBarSizes, taylor_bar_mesh
 
-__all__ = ["ArlequinBar", "ArlequinBarSizes", "MonoBar", "arlequin_bar_sizes", "taylor_bar_mesh"]
+__all__ = ["ArlequinBar", "MonoBar"]
 
 #: Part of the lateral surface, from the impact face, that the wall may meet (it folds onto the
 #: wall as the mushroom forms), as a fraction of the bar length.
 LATERAL_CONTACT = 0.3
-
-
-def taylor_bar_mesh(length: float, radius: float, elements_radial: int) -> skfem.MeshQuad:
-    """Meridional (r, z) Q1 mesh of the bar: ``elements_radial`` cells across the radius and
-    round(L / h) along the axis, h = R / elements_radial (nearly square cells), z ∈ [0, L]."""
-    n_r = int(elements_radial)
-    n_z = max(1, round(length / (radius / n_r)))
-    return skfem.MeshQuad.init_tensor(np.linspace(0.0, radius, n_r + 1),
-                                      np.linspace(0.0, length, n_z + 1))  # fmt: skip
 
 
 def _wall(mesh, offset, dofmap, material, tol, lateral, radius) -> LevelSetContact:
@@ -78,7 +74,9 @@ class MonoBar:
     length, radius : float
         L and R (m).
     elements_radial : int
-        Cells across the radius.
+        Cells across the radius (of the uniform mesh).
+    mesh : skfem.MeshQuad, optional
+        Another mesh of the bar instead (the graded one).
     material : J2Material
     fbar, backend, bulk_viscosity
         As :class:`~arlequin.models.FiniteStrainJ2`.
@@ -87,8 +85,9 @@ class MonoBar:
     fine_block = "bar"
 
     def __init__(self, length, radius, elements_radial, material: J2Material, fbar=True,
-                 backend="auto", bulk_viscosity=None) -> None:  # fmt: skip
-        mesh = taylor_bar_mesh(length, radius, elements_radial)
+                 backend="auto", bulk_viscosity=None, mesh=None) -> None:  # fmt: skip
+        if mesh is None:
+            mesh = taylor_bar_mesh(length, radius, elements_radial)
         self.mesh = mesh
         self.model = FiniteStrainJ2(mesh, material, "axisymmetric", fbar, backend=backend,
                                     bulk_viscosity=bulk_viscosity)  # fmt: skip
@@ -163,129 +162,6 @@ class MonoBar:
         render_taylor_bar(self.model, u, state, path, title)
 
 
-class ArlequinBarSizes:
-    """The nested meshes of :class:`ArlequinBar`, snapped to coarse cell edges (SI units).
-
-    Attributes
-    ----------
-    coarse_radial, coarse_axial : int
-        Coarse cells across the radius and along the bar.
-    ratio : int
-        Fine cells per coarse cell edge (k = coarse size / fine size).
-    patch_rows, band_rows : int
-        Coarse rows under the patch and in the gluing band (the band is the top of the patch).
-    coarse_size, fine_size : float
-        Cell edges across the radius (m).
-    patch_length, gluing_width : float
-        The snapped patch length and band width (m).
-    """
-
-    def __init__(self, coarse_radial, coarse_axial, ratio, patch_rows, band_rows, length,
-                 radius) -> None:  # fmt: skip
-        self.coarse_radial, self.coarse_axial, self.ratio = coarse_radial, coarse_axial, ratio
-        self.patch_rows, self.band_rows = patch_rows, band_rows
-        self.coarse_size = radius / coarse_radial
-        self.fine_size = self.coarse_size / ratio
-        self.axial_size = length / coarse_axial  # coarse cell height
-        self.patch_length = patch_rows * self.axial_size
-        self.gluing_width = band_rows * self.axial_size
-
-    def as_dict(self) -> dict[str, Any]:
-        return {
-            "coarse_radial": self.coarse_radial, "coarse_axial": self.coarse_axial,
-            "ratio": self.ratio, "patch_rows": self.patch_rows, "band_rows": self.band_rows,
-            "coarse_size": self.coarse_size, "fine_size": self.fine_size,
-            "patch_length": self.patch_length, "gluing_width": self.gluing_width,
-        }  # fmt: skip
-
-
-def _smallest_divisor(n: int) -> int | None:
-    for k in range(2, n + 1):
-        if n % k == 0:
-            return k
-    return None
-
-
-def arlequin_bar_sizes(
-    length: float,
-    radius: float,
-    fine_radial: int,
-    coarse_size: float | None = None,
-    patch_length: float | None = None,
-    gluing_width: float | None = None,
-) -> ArlequinBarSizes:
-    """Snap the Arlequin bar's sizes to nested meshes.
-
-    Parameters
-    ----------
-    length, radius : float
-        L and R (m).
-    fine_radial : int
-        Fine cells across the radius (fine size R / fine_radial).
-    coarse_size : float, optional
-        Coarse cell edge across the radius (m), a multiple k ≥ 1 of the fine size; default the
-        smallest multiple k ≥ 2 that divides ``fine_radial`` (2 for an even count).
-    patch_length : float, optional
-        Patch length from the impact face (m), rounded to whole coarse rows; default 0.9 L.
-    gluing_width : float, optional
-        Gluing band width (m), rounded to whole coarse rows (at least one); default two rows.
-
-    Raises
-    ------
-    ValueError
-        If the coarse size is not a multiple of the fine size, if the patch does not leave at
-        least one coarse row above it, or if the band does not leave at least one patch row
-        under it.
-    """
-    n_f = int(fine_radial)
-    fine = radius / n_f
-    if coarse_size is None:
-        k = _smallest_divisor(n_f)
-        if k is None:
-            raise ValueError(
-                f"with 1 fine cell across the radius the coarse cells cannot be larger; give "
-                f"more fine cells (got fine size {fine} m)"
-            )
-    else:
-        if not (math.isfinite(coarse_size) and coarse_size > 0.0):
-            raise ValueError(f"coarse_size must be positive and finite, got {coarse_size}")
-        ratio = coarse_size / fine
-        k = round(ratio)
-        if k < 1 or abs(ratio - k) > 1e-6 * ratio or n_f % k:
-            raise ValueError(
-                f"coarse_size must be a multiple of the fine size dividing the radius: got "
-                f"coarse_size={coarse_size} m, fine size {fine} m (ratio {ratio:.6g}) with "
-                f"{n_f} fine cells across the radius"
-            )
-    n_rc = n_f // k
-    n_zc = max(1, round(length / (radius / n_rc)))
-    hz = length / n_zc
-    if patch_length is None:
-        patch_length = 0.9 * length
-    if not (math.isfinite(patch_length) and 0.0 < patch_length < length):
-        raise ValueError(
-            f"patch_length must lie in (0, L = {length}) m, got patch_length={patch_length}"
-        )
-    rows = round(patch_length / hz)
-    if rows < 2 or rows > n_zc - 1:
-        raise ValueError(
-            f"patch_length={patch_length} m gives {rows} coarse rows of {hz:.4g} m; the patch "
-            f"needs at least 2 rows and must leave at least one of the {n_zc} rows above it"
-        )
-    if gluing_width is None:
-        band = 2
-    else:
-        if not (math.isfinite(gluing_width) and gluing_width > 0.0):
-            raise ValueError(f"gluing_width must be positive and finite, got {gluing_width}")
-        band = max(1, round(gluing_width / hz))
-    if band >= rows:
-        raise ValueError(
-            f"gluing_width={gluing_width} m gives a band of {band} coarse rows of {hz:.4g} m, "
-            f"the whole patch of {rows} rows; the band must leave patch rows under it"
-        )
-    return ArlequinBarSizes(n_rc, n_zc, k, rows, band, length, radius)
-
-
 class ArlequinBar:
     """The coarse linear-elastic bar plus the refined finite-strain J2 patch (module docstring).
 
@@ -325,14 +201,14 @@ class ArlequinBar:
         patch = Patch(self.model, gluing_width=s.gluing_width, weights=weights, epsilon=epsilon,
                       coupling=coupling, mediator=mediator, overlap_method="nested",
                       name="patch")  # fmt: skip
-        self.problem = ArlequinProblem(self.coarse, [patch])
+        # both models have u_r = 0 on the axis: the mediator space too (module docstring)
+        self.problem = ArlequinProblem(self.coarse, [patch], mediator_dirichlet="drop")
         tol = 1e-9 * radius
         for block in ("coarse", "patch"):
             self.problem.add_dirichlet(block, lambda x: x[0] < tol, components=[0])
         self.system = self.problem.system()
         self.coupling = self.problem.couplings[0]
         self.layout = self.problem.field_layout()
-        self._drop_axis_mediator_rows(tol)
         self.fine_weight = self.coupling.alpha_fine
         dm = self.system.dofmap
         # the wall's lateral reach stays below the gluing band
@@ -356,28 +232,6 @@ class ArlequinBar:
         self.fine_elements = int(fmesh.nelements)
         #: p: the patch's share of the fine elements of a uniform mesh at its resolution
         self.patch_fraction = s.patch_rows / s.coarse_axial
-
-    def _drop_axis_mediator_rows(self, tol: float) -> None:
-        """Remove the mediator functions of u_r on the axis.
-
-        Both displacement spaces have u_r = 0 on the axis, so the multiplier space is taken
-        with the same condition (the trace of the constrained spaces): the rows of those
-        mediator functions would otherwise duplicate the axis conditions (exactly so for the
-        fine mediator, whose rows tie every band dof) and carry their reactions, which
-        oscillate from step to step in an explicit run.
-        """
-        pc = self.coupling
-        carrier = self.coarse_mesh if pc.coupling.mediator == "coarse" else self.fine_mesh
-        med = np.asarray(pc.coupling.mediator_dofs)
-        keep = ~((med % 2 == 0) & (carrier.p[0, med // 2] < tol))
-        name = f"coupling:{pc.name}"
-        for i, con in enumerate(self.system.constraints):
-            if con.name == name:
-                self.system.constraints[i] = dataclasses.replace(
-                    con, matrix=con.matrix[np.nonzero(keep)[0]].tocsr()
-                )
-        block, dofs = self.layout.multipliers[name]
-        self.layout.multipliers[name] = (block, dofs[keep])
 
     def initial_velocity(self, velocity: float) -> np.ndarray:
         v0 = np.zeros(self.system.dofmap.n_dofs)

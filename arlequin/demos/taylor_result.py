@@ -38,7 +38,7 @@ ARLEQUIN_JSON_KEYS = ("coarse_elements", "fine_elements", "coarse_size", "fine_s
                       "patch_fraction")  # fmt: skip
 
 #: The models of the bar.
-MODELS = ("arlequin", "mono")
+MODELS = ("arlequin", "mono", "graded")
 
 
 class GluingBandPlasticityWarning(UserWarning):
