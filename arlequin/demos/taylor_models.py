@@ -184,7 +184,7 @@ class ArlequinBar:
     fine_block = "patch"
 
     def __init__(self, length, radius, sizes: ArlequinBarSizes, material: J2Material,
-                 weights="ramp", mediator="coarse", coupling="H1", epsilon=1e-3, fbar=True,
+                 weights="ramp", mediator="fine", coupling="H1", epsilon=1e-3, fbar=True,
                  backend="auto", bulk_viscosity=None) -> None:  # fmt: skip
         s = sizes
         self.sizes = s
