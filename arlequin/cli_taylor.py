@@ -56,22 +56,11 @@ def _cmd_taylor_bar(args: argparse.Namespace) -> int:
     }
     law_params = {k: v for k, v in law_params.items() if v is not None}
     bar, update = _progress_bar(args.t_end, args.quiet)
-    arlequin = {}
-    if args.model == "graded":
-        arlequin = {k: getattr(args, k) for k in ("patch_length", "coarse_size", "fine_size")}
-        arlequin = {k: v for k, v in arlequin.items() if v is not None}
-    elif args.model == "arlequin":
-        arlequin = {
-            "patch_length": args.patch_length, "gluing_width": args.gluing_width,
-            "coarse_size": args.coarse_size, "fine_size": args.fine_size,
-            "weights": args.weights, "mediator": args.mediator, "coupling": args.coupling,
-            "coarse_step_ratio": args.coarse_step_ratio, "band_warning": args.band_warning,
-        }  # fmt: skip
-    else:
-        given = [f"--{k.replace('_', '-')}" for k in ("patch_length", "gluing_width",
-                 "coarse_size", "fine_size") if getattr(args, k) is not None]  # fmt: skip
-        if given:
-            raise ValueError(f"{', '.join(given)} apply to --model arlequin or graded only")
+    # the Arlequin options given on the command line (run_taylor_bar refuses those that do not
+    # apply to the model, before any work)
+    names = ("patch_length", "gluing_width", "coarse_size", "fine_size", "weights", "mediator",
+             "coupling", "coarse_step_ratio", "band_warning")  # fmt: skip
+    arlequin = {k: getattr(args, k) for k in names if getattr(args, k) is not None}
     try:
         result = run_taylor_bar(
             model=args.model,
@@ -171,25 +160,25 @@ def add_taylor_bar(sub) -> None:
         metavar="W",
         help="arlequin: gluing band width at the patch's top (m, default 2 coarse rows)",
     )
-    p.add_argument("--weights", choices=["ramp", "constant"], default="ramp",
-                   help="arlequin: partition weights across the band")  # fmt: skip
-    p.add_argument("--mediator", choices=["coarse", "fine"], default="fine",
-                   help="arlequin: mediator space")  # fmt: skip
-    p.add_argument("--coupling", choices=["L2", "H1"], default="H1",
-                   help="arlequin: coupling operator")  # fmt: skip
+    p.add_argument("--weights", choices=["ramp", "constant"], default=None,
+                   help="arlequin: partition weights across the band (default ramp)")  # fmt: skip
+    p.add_argument("--mediator", choices=["coarse", "fine"], default=None,
+                   help="arlequin: mediator space (default fine)")  # fmt: skip
+    p.add_argument("--coupling", choices=["L2", "H1"], default=None,
+                   help="arlequin: coupling operator (default H1)")  # fmt: skip
     p.add_argument(
         "--coarse-step-ratio",
         type=int,
-        default=1,
+        default=None,
         metavar="M",
         help="arlequin: coarse steps per patch step (only 1 is implemented so far)",
     )
     p.add_argument(
         "--band-warning",
         type=float,
-        default=0.02,
+        default=None,
         metavar="EPS",
-        help="arlequin: warn if the plastic strain in the gluing band exceeds this",
+        help="arlequin: warn if the plastic strain in the gluing band exceeds this (default 0.02)",
     )
     p.add_argument("--t-end", type=float, default=80e-6, metavar="T", help="end time (s)")
     p.add_argument("--velocity", type=float, default=227.0, metavar="V", help="impact speed (m/s)")

@@ -32,6 +32,8 @@ from arlequin.models import (
 def run(fine_radial: int = 10, t_end: float = 80e-6) -> dict:
     """Final length and footprint radius (m) of the bar at ``t_end`` (s), ``fine_radial`` patch
     cells across the radius (even: the coarse cells are twice as large)."""
+    if fine_radial < 2 or fine_radial % 2:
+        raise ValueError(f"fine_radial must be an even number >= 2, got {fine_radial}")
     L, R, v0 = 32.4e-3, 3.2e-3, 227.0
     law = make_hardening("linear", yield_stress=0.4e9, modulus=0.1e9)
     copper = J2Material.with_law(117e9, 0.35, 8930.0, law)

@@ -77,6 +77,9 @@ def test_bad_sizes_are_refused(kwargs, match):
         ({"coarse_step_ratio": 0}, "coarse_step_ratio must be a positive integer"),
         ({"band_warning": -1.0}, "band_warning must be a non-negative"),
         ({"elements_radial": 1}, "coarse cells cannot be larger"),
+        ({"model": "mono", "mediator": "coarse"}, r"\['mediator'\] apply to model='arlequin' only"),
+        ({"model": "graded", "gluing_width": 1e-3}, "apply to model='arlequin' only"),
+        ({"mediatr": "fine"}, r"unknown parameters \['mediatr'\]"),
     ],
 )
 def test_bad_input_is_refused_before_any_work(kwargs, match, tmp_path):

@@ -48,16 +48,18 @@ def render_taylor_bar(model: Any, u: np.ndarray, state: Any, path: str, title: s
     x = model.current_coordinates(u)
     eqps = np.asarray(state.eqps).mean(axis=1)
     grid = _quad_grid(x, mesh.t, mirror=True)
-    grid.cell_data["equivalent plastic strain"] = np.concatenate([eqps, eqps])
+    grid.cell_data["equivalent plastic strain (cell mean)"] = np.concatenate([eqps, eqps])
     ref = _quad_grid(mesh.p, mesh.t, mirror=True).extract_feature_edges(
         boundary_edges=True, feature_edges=False, manifold_edges=False
     )
     plotter = pv.Plotter(off_screen=True, window_size=(1000, 1100))
     plotter.set_background("white")
-    bar_args = {"color": "black", "title": "equivalent plastic strain", "vertical": True,
-                "position_x": 0.85, "position_y": 0.25, "height": 0.5, "width": 0.06}
-    plotter.add_mesh(grid, scalars="equivalent plastic strain", cmap="viridis", show_edges=True,
-                     edge_color="#555555", line_width=0.3, scalar_bar_args=bar_args)  # fmt: skip
+    bar_args = {"color": "black", "title": "plastic strain (cell mean)",
+                "vertical": True, "position_x": 0.85, "position_y": 0.25, "height": 0.5,
+                "width": 0.06}  # fmt: skip
+    plotter.add_mesh(grid, scalars="equivalent plastic strain (cell mean)", cmap="viridis",
+                     show_edges=True, edge_color="#555555", line_width=0.3,
+                     scalar_bar_args=bar_args)  # fmt: skip
     plotter.add_mesh(ref, color="gray", line_width=1.0)
     plotter.add_text(title, position="upper_left", font_size=10, color="black")
     plotter.view_xy()
@@ -91,8 +93,9 @@ def render_arlequin_bar(bar: Any, u: np.ndarray, state: Any, path: str, title: s
     eqps = np.asarray(state.eqps).mean(axis=1)
     uc, uf = u[bar._c], u[bar._f]
     plotter = pv.Plotter(off_screen=True, shape=(1, 2), window_size=(1400, 1000))
-    bar_args = {"color": "black", "title": "equivalent plastic strain", "vertical": True,
-                "position_x": 0.80, "position_y": 0.25, "height": 0.5, "width": 0.05}
+    bar_args = {"color": "black", "title": "plastic strain (cell mean)",
+                "vertical": True, "position_x": 0.72, "position_y": 0.25, "height": 0.5,
+                "width": 0.05}  # fmt: skip
     band = fmesh.p[1] >= z_band - 1e-9 * s.patch_length
     edge_nodes = [np.nonzero(np.isclose(fmesh.p[1], z) & band)[0] for z in (z_band, s.patch_length)]
     for col in (0, 1):
@@ -109,8 +112,9 @@ def render_arlequin_bar(bar: Any, u: np.ndarray, state: Any, path: str, title: s
                          show_scalar_bar=False)  # fmt: skip
         patch = _quad_grid(xf, fmesh.t, mirror=False)
         if final:
-            patch.cell_data["equivalent plastic strain"] = eqps
-            plotter.add_mesh(patch, scalars="equivalent plastic strain", cmap="viridis",
+            patch.cell_data["equivalent plastic strain (cell mean)"] = eqps
+            plotter.add_mesh(patch, scalars="equivalent plastic strain (cell mean)",
+                             cmap="viridis",
                              show_edges=True, edge_color="#444444", line_width=0.2,
                              scalar_bar_args=bar_args)  # fmt: skip
         else:

@@ -87,7 +87,10 @@ _INPUT_UNITS = {
     "elements_radial": "1", "elements_axial": "1", "mesh_size": "m", "safety": "1",
     "estimate_every": "1", "sample_interval": "s", "frame_interval": "s", "voce_saturation": "Pa",
     "voce_rate": "1", "jc_b": "Pa", "jc_n": "1", "jc_c": "1", "jc_reference_rate": "1/s",
-    "bulk_viscosity_linear": "1", "bulk_viscosity_quadratic": "1",
+    "bulk_viscosity_linear": "1", "bulk_viscosity_quadratic": "1", "coarse_radial": "1",
+    "coarse_axial": "1", "ratio": "1", "patch_rows": "1", "band_rows": "1", "coarse_size": "m",
+    "fine_size": "m", "patch_length": "m", "gluing_width": "m", "epsilon": "1",
+    "band_warning": "1", "coarse_step_ratio": "1",
 }  # fmt: skip
 
 _RESULT_UNITS = {
@@ -95,7 +98,8 @@ _RESULT_UNITS = {
     "energy_balance_error": "1", "n_elements": "1", "mesh_size": "m", "n_steps": "1",
     "wall_time_s": "s", "initial_kinetic_energy": "J", "impact_loss": "J", "min_dt": "s",
     "max_plastic_strain_at": "m", "final_energies": "J", "qp_updates_per_second": "1/s",
-    "setup_time_s": "s", "coarse_elements": "1", "fine_elements": "1", "coarse_size": "m",
+    "setup_time_s": "s", "elements_radial": "1", "elements_axial": "1",
+    "coarse_elements": "1", "fine_elements": "1", "coarse_size": "m",
     "fine_size": "m", "patch_fraction": "1", "patch_length": "m", "gluing_width": "m",
     "band_max_plastic_strain": "1", "multiplier_chatter": "1",
     "multiplier_chatter_per_row": "1",
@@ -179,11 +183,11 @@ def run_taylor_bar(
     gluing_width: float | None = None,
     coarse_size: float | None = None,
     fine_size: float | None = None,
-    weights: str | PartitionWeights = "ramp",
-    mediator: str = "fine",
-    coupling: str = "H1",
-    coarse_step_ratio: int = 1,
-    band_warning: float = 0.02,
+    weights: str | PartitionWeights | None = None,
+    mediator: str | None = None,
+    coupling: str | None = None,
+    coarse_step_ratio: int | None = None,
+    band_warning: float | None = None,
     fbar: bool = True,
     backend: str = "auto",
     safety: float = 0.8,
@@ -198,10 +202,13 @@ def run_taylor_bar(
 
     Parameters
     ----------
-    model : {"arlequin", "mono"}
+    model : {"arlequin", "mono", "graded"}
         ``"arlequin"`` (default): a coarse linear-elastic bar plus a refined finite-strain J2
         patch over the impacted end (:class:`~arlequin.demos.taylor_models.ArlequinBar`);
-        ``"mono"``: one finite-strain mesh over the whole bar.
+        ``"mono"``: one uniform finite-strain mesh over the whole bar; ``"graded"``: one
+        conforming finite-strain mesh, the patch's fine cells over the patch region, a 2:1
+        transition row, the coarse cells above (:func:`~arlequin.demos.taylor_meshes.
+        graded_bar_mesh`).
     elements_radial : int, optional
         Cells across the radius (default 10; the fine cells of the patch under ``arlequin``); or
         ``mesh_size`` (m), the cell edge across the radius (then elements_radial =
@@ -224,19 +231,20 @@ def run_taylor_bar(
         ``arlequin`` only (m): the patch's length from the impact face (default 0.9 L), the
         gluing band's width at its top (default two coarse rows), both rounded to whole coarse
         rows, and the coarse cell edge across the radius (default twice the fine size, or the
-        smallest multiple dividing the radius); see
+        smallest multiple dividing the radius for an odd count: 3 or 5 cells across give one
+        coarse cell); ``graded`` uses patch_length and coarse_size too; see
         :func:`~arlequin.demos.taylor_models.arlequin_bar_sizes`.
-    weights, mediator, coupling : str
+    weights, mediator, coupling : str, optional
         ``arlequin`` only: ``"ramp"`` (default), ``"constant"`` (½ in the band) or any
         :class:`~arlequin.PartitionWeights`; the ``"fine"`` (default) or ``"coarse"`` mediator
         space; ``"H1"`` (default) or ``"L2"`` coupling. The fine mediator ties the patch to the
         coarse field everywhere in the band; the coarse one leaves the patch's fine-scale motion
         free there, and where the ramp makes the patch light (its top edge) the mediator's
         impulses raise spurious plastic flow (docs/arlequin_taylor.md).
-    coarse_step_ratio : int
+    coarse_step_ratio : int, optional
         ``arlequin`` only: coarse steps per patch step; 1 (the default, one step for the coupled
         system) is the only value implemented so far.
-    band_warning : float
+    band_warning : float, optional
         ``arlequin`` only: warn (:class:`GluingBandPlasticityWarning`) when ε̄p in the gluing
         band exceeds this (default 0.02): the coarse model there is elastic.
     fbar : bool
@@ -272,11 +280,18 @@ def run_taylor_bar(
                         ("radius", radius), ("sample_interval", sample_interval),
                         ("frame_interval", frame_interval)]:  # fmt: skip
         _positive(name, value)
+    only_arlequin = {k: v for k, v in (("gluing_width", gluing_width), ("weights", weights),
+                     ("band_warning", band_warning),
+                     ("mediator", mediator), ("coupling", coupling),
+                     ("coarse_step_ratio", coarse_step_ratio)) if v is not None}  # fmt: skip
+    if model != "arlequin" and only_arlequin:
+        raise ValueError(f"{sorted(only_arlequin)} apply to model='arlequin' only, got "
+                         f"model={model!r}")  # fmt: skip
     arlequin = model == "arlequin"
     nested = model in ("arlequin", "graded")  # the patch's sizes apply
     if not nested:
-        extra = {k: v for k, v in (("patch_length", patch_length), ("gluing_width", gluing_width),
-                                   ("coarse_size", coarse_size)) if v is not None}  # fmt: skip
+        extra = {k: v for k, v in (("patch_length", patch_length), ("coarse_size", coarse_size))
+                 if v is not None}  # fmt: skip
         if extra:
             raise ValueError(f"{sorted(extra)} apply to model='arlequin' or 'graded' only, got "
                              f"model={model!r}")  # fmt: skip
@@ -287,6 +302,15 @@ def run_taylor_bar(
         n_r = _elements_radial(elements_radial, mesh_size, radius)
     else:
         n_r = _fine_radial(elements_radial, mesh_size, fine_size, radius)
+    weights = "ramp" if weights is None else weights
+    mediator = "fine" if mediator is None else mediator
+    coupling = "H1" if coupling is None else coupling
+    coarse_step_ratio = 1 if coarse_step_ratio is None else coarse_step_ratio
+    band_warning = 0.02 if band_warning is None else band_warning
+    unknown = sorted(set(law_parameters) - {p for d in LAW_DEFAULTS.values() for p in d})
+    if unknown:
+        raise ValueError(f"unknown parameters {unknown}: neither an option of run_taylor_bar nor "
+                         f"a parameter of a hardening law")  # fmt: skip
     if coarse_step_ratio != 1:
         if isinstance(coarse_step_ratio, bool) or int(coarse_step_ratio) != coarse_step_ratio \
                 or coarse_step_ratio < 1:  # fmt: skip
