@@ -79,7 +79,7 @@ def _qoi(r) -> dict:
     }
 
 
-def compare(n: int) -> dict:
+def compare(n: int, coarse_size: float | None = None) -> dict:
     """Arlequin against the uniform fine mesh, in this process (see the module docstring)."""
     import warnings
 
@@ -87,7 +87,7 @@ def compare(n: int) -> dict:
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", GluingBandPlasticityWarning)
-        arl = run_taylor_bar(model="arlequin", elements_radial=n)
+        arl = run_taylor_bar(model="arlequin", elements_radial=n, coarse_size=coarse_size)
     uni = run_taylor_bar(model="mono", elements_radial=n)
     graded = run_taylor_bar(model="graded", elements_radial=n)
     a = arl.arlequin
@@ -96,6 +96,7 @@ def compare(n: int) -> dict:
     out = {
         "fine_cells_across": n,
         "patch_fraction": round(p, 4),
+        "coarse_size": a["coarse_size"],
         "arlequin": {**_qoi(arl), **{k: a[k] for k in ("coarse_elements", "fine_elements",
                      "band_max_plastic_strain", "multiplier_chatter_per_row")},
                      "band_warning": bool(caught)},
@@ -124,6 +125,8 @@ def main(argv: list[str] | None = None) -> int:
                         help="simulated time (s) of the numpy/numba comparison")  # fmt: skip
     parser.add_argument("--compare", type=int, default=None, metavar="N",
                         help="Arlequin vs the uniform mesh, N fine cells across")  # fmt: skip
+    parser.add_argument("--coarse-size", type=float, default=None,
+                        help="with --compare: the Arlequin coarse size (m)")  # fmt: skip
     parser.add_argument("--single", type=int, default=None, help=argparse.SUPPRESS)
     parser.add_argument("--no-fbar", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
@@ -131,7 +134,8 @@ def main(argv: list[str] | None = None) -> int:
         from arlequin.models.j2_kernel import warm_up
 
         warm_up()
-        print(json.dumps({"benchmark": "taylor_bar_compare", **compare(args.compare)}, indent=2))
+        out = compare(args.compare, args.coarse_size)
+        print(json.dumps({"benchmark": "taylor_bar_compare", **out}, indent=2))
         return 0
     if args.single is not None:
         print(json.dumps(one_level(args.single, not args.no_fbar, args.window)))
