@@ -13,10 +13,12 @@ import logging
 import sys
 from collections.abc import Sequence
 
+from . import __version__
 from .cli_common import NonFiniteResult
 from .cli_common import add_out as _add_out
 from .cli_common import check_writable as _check_writable
 from .cli_common import write_json as _write_json
+from .cli_info import add_info
 from .cli_taylor import add_taylor_bar
 from .contract import SimulationError
 
@@ -191,22 +193,24 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="arlequin", description="Arlequin multiscale coupling: demos and verification."
     )
-    parser.add_argument("-v", "--verbose", action="store_true", help="log progress (INFO)")
+    parser.add_argument("-v", "--verbose", action="store_true",
+                        help="log the library's progress (INFO; other libraries stay at WARNING)")
+    parser.add_argument("--version", action="version", version=f"arlequin {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     _add_patch_test(sub)
     _add_two_bars(sub)
     _add_wave(sub)
     add_taylor_bar(sub)
+    add_info(sub)
     return parser
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
-    logging.basicConfig(
-        level=logging.INFO if args.verbose else logging.WARNING,
-        format="%(levelname)s %(name)s: %(message)s",
-    )
+    logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
+    if args.verbose:  # the library's own messages, not scikit-fem's or numba's internals
+        logging.getLogger("arlequin").setLevel(logging.INFO)
     try:
         for attr in ("json", "plot"):
             _check_writable(getattr(args, attr, None), f"--{attr}")

@@ -91,3 +91,23 @@ def test_models_import_from_the_repository_root_without_the_installed_mapping():
     pkg, models = r.stdout.split()
     assert Path(pkg) == root / "arlequin" / "__init__.py"
     assert Path(models) == root / "models" / "__init__.py"
+
+
+def test_version_and_info(tmp_path, capsys):
+    import json
+
+    import pytest
+
+    import arlequin
+    from arlequin.cli import main
+
+    with pytest.raises(SystemExit) as exit_:
+        main(["--version"])
+    assert exit_.value.code == 0
+    assert capsys.readouterr().out.strip() == f"arlequin {arlequin.__version__}"
+    path = tmp_path / "info.json"
+    assert main(["info", "--no-render", "--json", str(path)]) == 0
+    report = json.loads(path.read_text())
+    assert report["versions"]["arlequin"] == arlequin.__version__
+    assert report["versions"]["numpy"] and report["numba_threads"] >= 1
+    assert "numba threads" in capsys.readouterr().out

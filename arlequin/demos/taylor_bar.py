@@ -451,13 +451,14 @@ def run_taylor_bar(
         assert isinstance(bar, ArlequinBar) and lam_history is not None
         s = bar.sizes
         band_eqps = bar.band_plastic_strain(state)
+        chatter = lam_history.chatter()
         result.arlequin = {
             "coarse_elements": bar.coarse_elements, "fine_elements": bar.fine_elements,
             "coarse_size": s.coarse_size, "fine_size": s.fine_size,
             "patch_fraction": bar.patch_fraction, "patch_length": s.patch_length,
             "gluing_width": s.gluing_width, "band_max_plastic_strain": band_eqps,
-            "multiplier_chatter": lam_history.chatter()["global"],
-            "multiplier_chatter_per_row": lam_history.chatter()["per_row"],
+            "multiplier_chatter": chatter["global"],
+            "multiplier_chatter_per_row": chatter["per_row"],
         }  # fmt: skip
         result.multiplier_history = lam_history
         if band_eqps > band_warning:

@@ -99,12 +99,14 @@ class TaylorBarResult(JsonResult):
     reference : dict
         The published values at 80 µs (m), :data:`TAYLOR_REFERENCE`.
     arlequin : dict or None
-        ``arlequin`` only, flattened into the JSON: coarse_elements, fine_elements, coarse_size
-        and fine_size (m, edges across the radius), patch_fraction (p, the patch's share of the
-        fine cells of a uniform mesh at its resolution), patch_length and gluing_width (m, as
+        ``arlequin`` (and, for its sizes, ``graded``), flattened into the JSON:
+        coarse_elements, fine_elements, coarse_size and fine_size (m, edges across the radius),
+        patch_fraction (p, the patch's share of the fine cells of a uniform mesh at its
+        resolution), patch_length and gluing_width (m, as
         snapped to coarse rows), band_max_plastic_strain (largest ε̄p in the gluing band),
         multiplier_chatter (max_n |λ_n − (λ_{n−1} + λ_{n+1})/2| / max |λ| over the steps and
-        mediator rows) and multiplier_chatter_per_row (the same against each row's own peak).
+        mediator rows) and multiplier_chatter_per_row (the same against each row's own peak,
+        rows whose peak exceeds 1% of the largest).
     model, u, state, setup : the finite-strain model, the final displacement of the whole
         system (m), the finite-strain model's final quadrature state and the set-up
         (:class:`~arlequin.demos.taylor_models.MonoBar` or ``ArlequinBar``), not in the JSON.
