@@ -14,7 +14,8 @@ __all__ = ["add_taylor_bar"]
 
 class _LazyBar:
     """A tqdm bar over the simulated time (µs) with ETA on stderr, opened at the first update
-    (so that input errors, raised before any work, print no bar)."""
+    (so that input errors, raised before any work, print no bar); off when stderr is not a
+    terminal."""
 
     def __init__(self, total: float) -> None:
         self.total = total
@@ -29,6 +30,7 @@ class _LazyBar:
                 unit="µs",
                 desc="simulated time",
                 leave=False,
+                disable=None,  # off when stderr is not a terminal (logs, pipes, CI)
                 bar_format="{l_bar}{bar}| {n:.1f}/{total:.1f} µs [{elapsed}<{remaining}]",
             )
         self.bar.n = round(t * 1e6, 3)

@@ -40,3 +40,22 @@ def test_arlequin_taylor_bar_tutorial_is_the_demo():
     assert out["n_steps"] == demo.n_steps
     assert out["final_length"] == pytest.approx(demo.final_length, rel=1e-12)
     assert out["mushroom_radius"] == pytest.approx(demo.mushroom_radius, rel=1e-12)
+
+
+def test_two_bars_example_runs_small(tmp_path):
+    # the figures of docs/contact.md at a small size; the picture goes where it is asked to
+    out = load("two_bars").run(elements=20, refinement=(20, 40), blocks=False,
+                               plot=str(tmp_path / "two_bars.png"))  # fmt: skip
+    assert set(out) >= {"bars", "wall", "energy_loss_vs_elements"}
+    # the level-set interface velocity is exact (docs/contact.md: rms 1e-13 at 100 elements)
+    assert out["bars"]["levelset-theta"]["velocity_rms_error"] < 1e-10
+    assert (tmp_path / "two_bars.png").stat().st_size > 0
+
+
+# every example is run by the suite: the guard fails when a new one is not
+COVERED = {"refined_patch", "arlequin_taylor_bar", "two_bars", "plate_with_hole"}
+
+
+def test_every_example_is_covered():
+    names = {p.stem for p in EXAMPLES.glob("*.py")}
+    assert names == COVERED, f"examples not run by the test suite: {sorted(names - COVERED)}"

@@ -269,3 +269,23 @@ def test_constraint_work_agrees_with_the_integrators(integrator):
     # more than that: measured 1.0e-3 relative
     tol = 2e-3 if integrator == "hht" else 1e-12
     assert own == pytest.approx(r.total_constraint_work[-1], rel=tol)
+
+
+def test_verbose_runs_log_their_progress(monkeypatch, caplog):
+    # `arlequin -v`: every LOG_INTERVAL seconds of wall time one line with the step, t and dt
+    import logging
+
+    import numpy as np
+    import skfem
+
+    from arlequin.integrators import driver, solve
+    from arlequin.models import IsotropicElastic, LinearElastic
+    from arlequin.system import Block, BlockTerm, CoupledSystem
+
+    monkeypatch.setattr(driver, "LOG_INTERVAL", 0.0)
+    bar = LinearElastic(skfem.MeshLine(np.linspace(0, 1, 11)), IsotropicElastic(1e9, 0.0, 1e3))
+    system = CoupledSystem([Block("bar", bar, [BlockTerm(bar)])])
+    with caplog.at_level(logging.INFO, logger="arlequin.integrators.driver"):
+        solve(system, "explicit", n_steps=3, v0=np.ones(bar.n_dofs))
+    lines = [r.getMessage() for r in caplog.records if r.name == "arlequin.integrators.driver"]
+    assert len(lines) == 3 and lines[-1].startswith("step 3, t = ")

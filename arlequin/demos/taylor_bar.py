@@ -1,7 +1,7 @@
 """The Taylor bar impact: finite-strain J2, explicit dynamics, the level-set wall.
 
 A copper bar (length L, radius R, axisymmetric Q1 F-bar cells) moving at −v₀ along z touches a
-rigid frictionless wall z = 0 at t = 0 (DESIGN §4: L = 32.4 mm, R = 3.2 mm, v₀ = 227 m/s,
+rigid frictionless wall z = 0 at t = 0 (L = 32.4 mm, R = 3.2 mm, v₀ = 227 m/s,
 E = 117 GPa, ν = 0.35, ρ = 8930 kg/m³, σ_y0 = 0.4 GPa, H = 0.1 GPa, 80 µs). Three models
 (:mod:`arlequin.demos.taylor_models`): ``arlequin`` (default) a coarse linear-elastic bar plus a
 refined finite-strain patch over the impacted end, glued by a mediator in a band at the patch's

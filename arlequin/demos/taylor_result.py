@@ -20,7 +20,7 @@ __all__ = [
     "TaylorBarResult",
 ]
 
-#: The keys of the JSON document of ``arlequin taylor-bar --json`` (the Interface of issue 10).
+#: The keys of the JSON document of ``arlequin taylor-bar --json``, in their interface order.
 JSON_KEYS = (
     "final_length",
     "mushroom_radius",
@@ -33,7 +33,7 @@ JSON_KEYS = (
     "history",
 )
 
-#: The keys ``--model arlequin`` adds (the Interface of issue 11).
+#: The keys ``--model arlequin`` adds.
 ARLEQUIN_JSON_KEYS = ("coarse_elements", "fine_elements", "coarse_size", "fine_size",
                       "patch_fraction")  # fmt: skip
 
@@ -45,7 +45,7 @@ class GluingBandPlasticityWarning(UserWarning):
     """Plastic flow reached the gluing band, where the coarse (elastic) model is glued."""
 
 
-#: Published converged values at 80 µs (DESIGN §4: 3D, 1.5M elements), m.
+#: Published converged values at 80 µs (3D, 1.5M elements), m.
 TAYLOR_REFERENCE = {"final_length": 21.43e-3, "mushroom_radius": 7.23e-3}
 
 @dataclass

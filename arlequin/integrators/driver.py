@@ -8,7 +8,9 @@ through a :class:`~arlequin.integrators.recorder.Recorder` into a :class:`Dynami
 from __future__ import annotations
 
 import inspect
+import logging
 import math
+import time
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -20,6 +22,22 @@ from .controllers import FixedStep
 from .recorder import Recorder
 from .registry import get_integrator
 from .result import DynamicResult
+
+logger = logging.getLogger(__name__)
+
+#: Wall-time interval (s) of the progress lines logged at INFO (``arlequin -v``).
+LOG_INTERVAL = 2.0
+
+
+def _log_progress(integ: Integrator) -> None:
+    """One INFO line: step, time, step size and the kinetic energy plus the internal work (the
+    strain energy of linear blocks)."""
+    try:
+        energy = f"{integ.total_energy():.6e} J"
+    except Exception:  # an integrator without energies: the kinematics only
+        energy = "n/a"
+    logger.info("step %d, t = %.6e s, dt = %.3e s, kinetic energy + internal work %s",
+                integ.step_count, integ.t, float(integ.step_size or integ.dt), energy)
 
 __all__ = ["options_of", "solve"]
 
@@ -172,6 +190,8 @@ def solve(
         return rec.result(1, "stopped by the callback at the initial state")
     pending = list(times[times > t0]) if times is not None else None
     k = 0
+    verbose = logger.isEnabledFor(logging.INFO)
+    next_log = time.perf_counter() + LOG_INTERVAL
     while True:
         if n_steps is not None and k >= n_steps:
             break
@@ -186,6 +206,9 @@ def solve(
         k += 1
         for listener in on_step:
             listener(integ)
+        if verbose and time.perf_counter() >= next_log:
+            _log_progress(integ)
+            next_log = time.perf_counter() + LOG_INTERVAL
         last = integ.status == "finished" or (n_steps is not None and k == n_steps)
         if pending is not None:
             take = bool(pending) and integ.t >= pending[0] - 1e-12 * float(integ.step_size)
