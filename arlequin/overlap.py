@@ -11,13 +11,16 @@ cell's own reference coordinates, ``P @ u`` represents them *exactly* on I, so t
 products of coarse and fine functions and a piecewise-linear weight, integrated on I with enough
 quadrature, is exact. Three constructions:
 
-``nested``        the patch refines the coarse cells it covers: I is the fine mesh itself,
-                  P_fine = identity. Detected automatically (coarse functions are reproduced by
-                  their fine interpolants at interior points of every fine cell to 1e-10).
-``merged``        1D non-nested: I is the line mesh on the merged breakpoints of both meshes.
-``intersection``  2D non-nested simplices: I is made of the triangles of the exact polygon
-                  intersections of fine and coarse cells (shapely/GEOS clipping, then a fan
-                  triangulation), each with its own nodes (a discontinuous P1 space on I).
+``nested``
+    the patch refines the coarse cells it covers: I is the fine mesh itself, P_fine = identity.
+    Detected automatically (coarse functions are reproduced by their fine interpolants at
+    interior points of every fine cell to 1e-10).
+``merged``
+    1D non-nested: I is the line mesh on the merged breakpoints of both meshes.
+``intersection``
+    2D non-nested simplices: I is made of the triangles of the exact polygon intersections of
+    fine and coarse cells (shapely/GEOS clipping, then a fan triangulation), each with its own
+    nodes (a discontinuous P1 space on I).
 
 3D non-nested meshes and non-nested quadrilaterals are refused with a clear error: there the
 intersection is not implemented (use a nested patch).

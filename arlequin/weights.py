@@ -4,10 +4,13 @@ In the overlap S of a coarse model and a patch, α_coarse + α_fine = 1. With ``
 from a point of the patch to the patch's *interior boundary* (the part of its boundary inside the
 coarse domain) and ``w`` the gluing-band width:
 
-``RampWeights``      α_coarse = a − (a − ε) min(d / w, 1)   (continuous, α_coarse = a on the
-                     interior boundary, default a = 1; piecewise linear in d)
-``ConstantWeights``  α_coarse = ``value`` for d < w, ε beyond (cell-wise constant)
-``CallableWeights``  user functions α_coarse(x), α_fine(x)
+``RampWeights``
+    α_coarse = a − (a − ε) min(d / w, 1) (continuous, α_coarse = a on the interior boundary,
+    default a = 1; piecewise linear in d)
+``ConstantWeights``
+    α_coarse = ``value`` for d < w, ε beyond (cell-wise constant)
+``CallableWeights``
+    user functions α_coarse(x), α_fine(x)
 
 Beyond the band, inside the patch, the fine model carries the energy: α_coarse = ε (a small
 positive floor, so the coarse problem stays non-singular), α_fine = 1 − ε.

@@ -19,7 +19,7 @@ the contact forces on the bar, the loss of stopping the impact face at t = 0 inc
 = ½ v₀·M v₀ with the lumped mass. Reported: the final length (axial position of the top-face
 node on the axis), the footprint (mushroom) radius (the largest distance from the axis of a
 node of the impact face), the maximum equivalent plastic strain and the balance error
-max_t |KE + W_el + D_p + D_visc + W_c − W_coupling − KE_0| / KE_0 (W_coupling, the net work of
+max_t abs(KE + W_el + D_p + D_visc + W_c − W_coupling − KE_0) / KE_0 (W_coupling, the net work of
 the mediator's forces, is zero on one mesh). SI units throughout.
 
 The run writes its results as it goes (``out=DIR``): results.json (inputs with units, then the

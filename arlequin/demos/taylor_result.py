@@ -61,7 +61,7 @@ class TaylorBarResult(JsonResult):
     max_plastic_strain : float
         Largest equivalent plastic strain ε̄p over the quadrature points at the end.
     energy_balance_error : float
-        max over the records of |KE + W_el + D_p + D_visc + W_c − W_coupling − KE_0| / KE_0
+        max over the records of abs(KE + W_el + D_p + D_visc + W_c − W_coupling − KE_0) / KE_0
         (W_coupling, the net work of the coupling forces, is 0 on one mesh).
     n_elements : int
         Cells of the mesh (``arlequin``: coarse and fine cells).
@@ -104,7 +104,7 @@ class TaylorBarResult(JsonResult):
         patch_fraction (p, the patch's share of the fine cells of a uniform mesh at its
         resolution), patch_length and gluing_width (m, as
         snapped to coarse rows), band_max_plastic_strain (largest ε̄p in the gluing band),
-        multiplier_chatter (max_n |λ_n − (λ_{n−1} + λ_{n+1})/2| / max |λ| over the steps and
+        multiplier_chatter (max_n abs(λ_n − (λ_{n−1} + λ_{n+1})/2) / max abs(λ) over the steps and
         mediator rows) and multiplier_chatter_per_row (the same against each row's own peak,
         rows whose peak exceeds 1% of the largest).
     model, u, state, setup : the finite-strain model, the final displacement of the whole

@@ -78,8 +78,8 @@ class SaddlePoint:
         """Relative residual of (u, λ) in the discrete equations, u the full vector.
 
         The larger of ‖[K u + Bᵀλ − f]_free‖ / max(‖K u‖, ‖f‖, ‖Bᵀλ‖) (equilibrium rows) and
-        ‖B u − g‖ / ‖|B| |u|‖ (constraint rows, measured against their own scale: the two kinds
-        of rows have different units and magnitudes).
+        ‖B u − g‖ / ‖abs(B) abs(u)‖ (constraint rows, measured against their own scale: the two
+        kinds of rows have different units and magnitudes).
         """
         b = self.constraints
         r1 = (self.stiffness @ u + b.T @ multipliers - self.load)[self.free]
