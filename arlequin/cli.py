@@ -14,7 +14,7 @@ import sys
 from collections.abc import Sequence
 
 from . import __version__
-from .cli_common import NonFiniteResult
+from .cli_common import NonFiniteResult, progress_bar
 from .cli_common import add_out as _add_out
 from .cli_common import check_writable as _check_writable
 from .cli_common import write_json as _write_json
@@ -144,17 +144,23 @@ def _add_two_bars(sub) -> None:
 def _cmd_wave(args: argparse.Namespace) -> int:
     from .demos.wave import plot_wave, run_wave
 
-    result = run_wave(
-        ratio=args.ratio,
-        pulse_width=args.pulse_width,
-        gluing_width=args.gluing_width,
-        coupling=args.coupling,
-        mediator=args.mediator,
-        weights=args.weights,
-        integrator=args.integrator,
-        dt=args.dt,
-        out=args.out,
-    )
+    bar, update = progress_bar(100.0, "%", args.quiet, scale=100.0, label="coupled run")
+    try:
+        result = run_wave(
+            ratio=args.ratio,
+            pulse_width=args.pulse_width,
+            gluing_width=args.gluing_width,
+            coupling=args.coupling,
+            mediator=args.mediator,
+            weights=args.weights,
+            integrator=args.integrator,
+            dt=args.dt,
+            out=args.out,
+            progress=update,
+        )
+    finally:
+        if bar is not None:
+            bar.close()
     print(result.summary())
     _write_json(args.json, result.to_json())
     if args.plot:
@@ -185,6 +191,7 @@ def _add_wave(sub) -> None:
     )
     p.add_argument("--json", metavar="PATH", default=None, help="write the results as JSON")
     p.add_argument("--plot", metavar="PNG", default=None, help="write a picture of the snapshot")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
     _add_out(p)
     p.set_defaults(func=_cmd_wave)
 

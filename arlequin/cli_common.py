@@ -7,7 +7,14 @@ import json
 import math
 import os
 
-__all__ = ["NonFiniteResult", "add_out", "check_writable", "write_json"]
+__all__ = [
+    "NonFiniteResult",
+    "ProgressBar",
+    "add_out",
+    "check_writable",
+    "progress_bar",
+    "write_json",
+]
 
 
 class NonFiniteResult(RuntimeError):
@@ -64,3 +71,53 @@ def add_out(p: argparse.ArgumentParser) -> None:
         default=None,
         help="write a results folder: results.json, history.csv, fields/*.xdmf, pictures",
     )
+
+
+class ProgressBar:
+    """A tqdm bar with ETA on stderr, opened at the first update (so that input errors, raised
+    before any work, print no bar); off when stderr is not a terminal.
+
+    Parameters
+    ----------
+    total : float
+        The end of the bar, in ``unit``.
+    unit : str
+    scale : float
+        ``update(x)`` shows ``x * scale`` (e.g. seconds of simulated time shown in µs).
+    label : str
+    """
+
+    def __init__(self, total: float, unit: str, scale: float = 1.0,
+                 label: str = "progress") -> None:  # fmt: skip
+        self.total, self.unit, self.scale, self.label = total, unit, scale, label
+        self.bar = None
+
+    def update(self, x: float) -> None:
+        if self.bar is None:
+            from tqdm import tqdm
+
+            self.bar = tqdm(
+                total=round(self.total, 3),
+                unit=self.unit,
+                desc=self.label,
+                leave=False,
+                disable=None,  # off when stderr is not a terminal (logs, pipes, CI)
+                bar_format="{l_bar}{bar}| {n:.1f}/{total:.1f} " + self.unit
+                + " [{elapsed}<{remaining}]",
+            )
+        self.bar.n = round(x * self.scale, 3)
+        self.bar.refresh()
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+
+
+def progress_bar(total: float, unit: str, quiet: bool, scale: float = 1.0,
+                 label: str = "progress"):  # fmt: skip
+    """(bar, update): a lazily opened :class:`ProgressBar` and its update, or (None, None) when
+    ``quiet``."""
+    if quiet:
+        return None, None
+    bar = ProgressBar(total, unit, scale, label)
+    return bar, bar.update

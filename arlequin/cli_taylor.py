@@ -7,46 +7,9 @@ from __future__ import annotations
 
 import argparse
 
-from .cli_common import add_out, write_json
+from .cli_common import add_out, progress_bar, write_json
 
 __all__ = ["add_taylor_bar"]
-
-
-class _LazyBar:
-    """A tqdm bar over the simulated time (µs) with ETA on stderr, opened at the first update
-    (so that input errors, raised before any work, print no bar); off when stderr is not a
-    terminal."""
-
-    def __init__(self, total: float) -> None:
-        self.total = total
-        self.bar = None
-
-    def update(self, t: float) -> None:
-        if self.bar is None:
-            from tqdm import tqdm
-
-            self.bar = tqdm(
-                total=round(self.total * 1e6, 3),
-                unit="µs",
-                desc="simulated time",
-                leave=False,
-                disable=None,  # off when stderr is not a terminal (logs, pipes, CI)
-                bar_format="{l_bar}{bar}| {n:.1f}/{total:.1f} µs [{elapsed}<{remaining}]",
-            )
-        self.bar.n = round(t * 1e6, 3)
-        self.bar.refresh()
-
-    def close(self) -> None:
-        if self.bar is not None:
-            self.bar.close()
-
-
-def _progress_bar(total: float, quiet: bool):
-    """(bar, update): a lazily opened progress bar and its update, or (None, None) when quiet."""
-    if quiet:
-        return None, None
-    bar = _LazyBar(total)
-    return bar, bar.update
 
 
 def _cmd_taylor_bar(args: argparse.Namespace) -> int:
@@ -57,7 +20,8 @@ def _cmd_taylor_bar(args: argparse.Namespace) -> int:
         for k in ("voce_saturation", "voce_rate", "jc_b", "jc_n", "jc_c", "jc_reference_rate")
     }
     law_params = {k: v for k, v in law_params.items() if v is not None}
-    bar, update = _progress_bar(args.t_end, args.quiet)
+    bar, update = progress_bar(args.t_end * 1e6, "µs", args.quiet, scale=1e6,
+                               label="simulated time")  # fmt: skip
     # the Arlequin options given on the command line (run_taylor_bar refuses those that do not
     # apply to the model, before any work)
     names = ("patch_length", "gluing_width", "coarse_size", "fine_size", "weights", "mediator",

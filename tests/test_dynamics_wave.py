@@ -161,3 +161,15 @@ def test_cli_wave_writes_json(tmp_path):
     assert set(data) == KEYS
     assert data["reflected_energy_fraction"] <= 1e-4  # ramp, coarse mediator, L2, W ≥ 10
     assert png.stat().st_size > 0
+
+
+def test_wave_reports_progress():
+    # the CLI's bar follows the coupled run's steps: monotone, ending at the last step
+    import itertools
+
+    from arlequin.demos.wave import run_wave
+
+    seen: list[float] = []
+    run_wave(ratio=2, progress=seen.append)
+    assert seen[-1] == 1.0 and all(b >= a for a, b in itertools.pairwise(seen))
+    assert 50 <= len(seen) <= 402  # about 200 updates, not one per step

@@ -111,3 +111,37 @@ def test_version_and_info(tmp_path, capsys):
     assert report["versions"]["arlequin"] == arlequin.__version__
     assert report["versions"]["numpy"] and report["numba_threads"] >= 1
     assert "numba threads" in capsys.readouterr().out
+
+
+def test_progress_bar_shows_in_a_terminal():
+    # a pseudo-terminal as stderr: tqdm draws the bar there (it stays off in pipes and logs)
+    import fcntl
+    import os
+    import pty
+    import struct
+    import subprocess
+    import sys
+    import termios
+
+    master, slave = pty.openpty()
+    # a terminal of 24 x 100 characters (a pty has none by default, and tqdm draws nothing)
+    fcntl.ioctl(slave, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 100, 0, 0))
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "arlequin.cli", "taylor-bar", "--model", "mono",
+         "--elements-radial", "3", "--t-end", "3e-6"],
+        stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=slave,
+    )  # fmt: skip
+    os.close(slave)
+    out = b""
+    while True:
+        try:
+            chunk = os.read(master, 4096)
+        except OSError:  # the child closed the terminal
+            break
+        if not chunk:
+            break
+        out += chunk
+    assert proc.wait(timeout=120) == 0
+    os.close(master)
+    text = out.decode("utf-8", "replace")
+    assert "simulated time" in text and "3.0/3.0 µs" in text and "100%" in text

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import logging
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -161,6 +162,7 @@ def run_wave(
     epsilon: float = 1e-3,
     length: float | None = None,
     out: str | Path | None = None,
+    progress: Callable[[float], None] | None = None,
 ) -> WaveResult:
     """Run the 1D wave demo (see the module docstring).
 
@@ -190,6 +192,9 @@ def run_wave(
         series (51 frames: displacement, velocity, alpha, the multiplier field) and wave.png.
         The result then keeps the coupled run's :class:`~arlequin.integrators.DynamicResult`
         with its fields (``result.dynamic``).
+    progress : callable, optional
+        ``progress(fraction)`` with the fraction of the coupled run's steps done, about 200
+        times over the run (the CLI's progress bar).
 
     Returns
     -------
@@ -256,6 +261,14 @@ def run_wave(
     if folder is not None:
         frames = np.linspace(0.0, n_steps * dt, 51)
         writers.append(DynamicRunWriter(folder, system, problem.field_layout(), frames))
+    if progress is not None:
+        every = max(1, n_steps // 200)
+
+        def report(integ, every=every, n=n_steps) -> None:
+            if integ.step_count % every == 0 or integ.step_count == n:
+                progress(integ.step_count / n)
+
+        writers.append(report)
     res = solve(system, name, n_steps=n_steps, dt=dt, u0=u0, v0=v0, on_record=writers,
                 save_fields=folder is not None, **opts)  # fmt: skip
     # reference: the coarse model alone, same pulse, integrator and dt
