@@ -12,9 +12,37 @@ from .cli_common import add_out, progress_bar, write_json
 __all__ = ["add_taylor_bar"]
 
 
+#: Options that may come with ``--resume`` (the inputs come from the checkpoint).
+_RESUME_OPTIONS = {"out", "json", "quiet", "resume", "func", "command", "verbose", "defaults"}
+
+
+def _cmd_resume(args: argparse.Namespace) -> int:
+    from .demos.taylor_bar import resume_taylor_bar
+    from .demos.taylor_checkpoint import load_checkpoint
+
+    given = sorted(f"--{k.replace('_', '-')}" for k, v in vars(args).items()
+                   if k not in _RESUME_OPTIONS and v != args.defaults.get(k))  # fmt: skip
+    if given:
+        raise ValueError(f"--resume continues with the inputs of the checkpoint; drop {given}")
+    if args.out is None:
+        raise ValueError("--resume needs --out DIR, the results folder of the interrupted run")
+    t_end = load_checkpoint(args.out, None)["call"]["t_end"]
+    bar, update = progress_bar(t_end * 1e6, "µs", args.quiet, scale=1e6, label="simulated time")
+    try:
+        result = resume_taylor_bar(args.out, progress=update)
+    finally:
+        if bar is not None:
+            bar.close()
+    print(result.summary())
+    write_json(args.json, result.to_json())
+    return 0
+
+
 def _cmd_taylor_bar(args: argparse.Namespace) -> int:
     from .demos.taylor_bar import run_taylor_bar
 
+    if args.resume:
+        return _cmd_resume(args)
     law_params = {
         k: getattr(args, k)
         for k in ("voce_saturation", "voce_rate", "jc_b", "jc_n", "jc_c", "jc_reference_rate")
@@ -225,4 +253,11 @@ def add_taylor_bar(sub) -> None:
     p.add_argument("--json", metavar="PATH", default=None, help="write the results as JSON")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     add_out(p)
+    p.add_argument(
+        "--resume",
+        action="store_true",
+        help="continue the interrupted run of --out DIR from its last checkpoint (written every "
+        "10 µs of simulated time), with its recorded inputs",
+    )
     p.set_defaults(func=_cmd_taylor_bar)
+    p.set_defaults(defaults={a.dest: a.default for a in p._actions})

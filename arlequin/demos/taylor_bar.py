@@ -33,7 +33,6 @@ and taylor_bar_history.png.
 from __future__ import annotations
 
 import logging
-import math
 import time
 import warnings
 from collections.abc import Callable
@@ -46,7 +45,15 @@ from ..integrators import CriticalFraction, solve
 from ..io import ResultsFolder
 from ..models import HARDENING_LAWS, BulkViscosity, J2Material, make_hardening
 from ..weights import PartitionWeights
-from .taylor_meshes import arlequin_bar_sizes, graded_bar_mesh, taylor_bar_mesh
+from .taylor_checkpoint import CheckpointWriter, load_checkpoint, read_frames
+from .taylor_meshes import (
+    arlequin_bar_sizes,
+    elements_radial_of,
+    fine_radial,
+    graded_bar_mesh,
+    positive,
+    taylor_bar_mesh,
+)
 from .taylor_models import ArlequinBar, MonoBar
 from .taylor_record import HISTORY_UNITS, MultiplierHistory, TaylorRecorder, write_results
 from .taylor_result import (
@@ -67,6 +74,7 @@ __all__ = [
     "GluingBandPlasticityWarning",
     "TaylorBarResult",
     "hardening_parameters",
+    "resume_taylor_bar",
     "run_taylor_bar",
     "taylor_bar_mesh",
 ]
@@ -128,41 +136,6 @@ def hardening_parameters(law: str, yield_stress: float, hardening: float, **para
                           reference_rate=p["jc_reference_rate"])  # fmt: skip
 
 
-def _positive(name: str, value: Any) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.number)):
-        raise ValueError(f"{name} must be a number, got {name}={value!r}")
-    if not (math.isfinite(value) and value > 0.0):
-        raise ValueError(f"{name} must be positive and finite, got {name}={value}")
-    return float(value)
-
-
-def _elements_radial(elements_radial, mesh_size, radius) -> int:
-    if elements_radial is not None and mesh_size is not None:
-        raise ValueError(
-            f"give elements_radial or mesh_size, not both (got elements_radial={elements_radial}, "
-            f"mesh_size={mesh_size})"
-        )
-    if mesh_size is not None:
-        h = _positive("mesh_size", mesh_size)
-        if h > radius:
-            raise ValueError(f"mesh_size must not exceed the radius {radius} m, got {h}")
-        return max(1, round(radius / h))
-    n = 10 if elements_radial is None else elements_radial
-    if isinstance(n, bool) or int(n) != n or n < 1:
-        raise ValueError(f"elements_radial must be a positive integer, got elements_radial={n}")
-    return int(n)
-
-
-def _fine_radial(elements_radial, mesh_size, fine_size, radius) -> int:
-    """Fine cells across the radius from the three aliases (the Arlequin and graded models)."""
-    given = [(k, v) for k, v in (("elements_radial", elements_radial), ("mesh_size", mesh_size),
-                                 ("fine_size", fine_size)) if v is not None]  # fmt: skip
-    if len(given) > 1:
-        raise ValueError(f"give one of elements_radial, mesh_size or fine_size, got {dict(given)}")
-    size = fine_size if fine_size is not None else mesh_size
-    return _elements_radial(elements_radial, size, radius)
-
-
 def run_taylor_bar(
     model: str = "arlequin",
     elements_radial: int | None = None,
@@ -196,6 +169,8 @@ def run_taylor_bar(
     frame_interval: float = 2e-6,
     out: str | Path | None = None,
     progress: Callable[[float], None] | None = None,
+    checkpoint_interval: float = 10e-6,
+    resume: bool = False,
     **law_parameters: float,
 ) -> TaylorBarResult:
     """Run the Taylor bar impact (see the module docstring).
@@ -262,6 +237,13 @@ def run_taylor_bar(
         Results folder, written as the run goes.
     progress : callable, optional
         ``progress(t)`` at every record (the CLI's progress bar).
+    checkpoint_interval : float
+        With ``out``: simulated time (s) between checkpoints (``checkpoint.pkl`` in the
+        folder, default 10 µs; removed when the run completes).
+    resume : bool
+        Continue the interrupted run of the folder ``out`` from its last checkpoint (the inputs
+        must be the same; :func:`resume_taylor_bar` reads them from the checkpoint). Everything
+        written until the checkpoint is kept and the values are those of an uninterrupted run.
 
     Returns
     -------
@@ -274,12 +256,16 @@ def run_taylor_bar(
         run fails (an inverted cell names the cell, the step and the time), with the results
         folder marked failed and everything recorded until then kept.
     """
+    call = {k: v for k, v in locals().items()
+            if k not in ("out", "progress", "resume", "law_parameters")}  # fmt: skip
+    call.update(law_parameters)
     if model not in MODELS:
         raise ValueError(f"model must be one of {MODELS}, got {model!r}")
+    positive("checkpoint_interval", checkpoint_interval)
     for name, value in [("t_end", t_end), ("velocity", velocity), ("length", length),
                         ("radius", radius), ("sample_interval", sample_interval),
                         ("frame_interval", frame_interval)]:  # fmt: skip
-        _positive(name, value)
+        positive(name, value)
     only_arlequin = {k: v for k, v in (("gluing_width", gluing_width), ("weights", weights),
                      ("band_warning", band_warning),
                      ("mediator", mediator), ("coupling", coupling),
@@ -299,9 +285,9 @@ def run_taylor_bar(
             raise ValueError(f"fine_size applies to model='arlequin' or 'graded' only (use "
                              f"mesh_size), got "
                              f"model={model!r}")  # fmt: skip
-        n_r = _elements_radial(elements_radial, mesh_size, radius)
+        n_r = elements_radial_of(elements_radial, mesh_size, radius)
     else:
-        n_r = _fine_radial(elements_radial, mesh_size, fine_size, radius)
+        n_r = fine_radial(elements_radial, mesh_size, fine_size, radius)
     weights = "ramp" if weights is None else weights
     mediator = "fine" if mediator is None else mediator
     coupling = "H1" if coupling is None else coupling
@@ -384,6 +370,9 @@ def run_taylor_bar(
     v0 = bar.initial_velocity(velocity)
     ke0 = 0.5 * float(v0 @ (bar.lumped_mass() * v0))
     frames = np.arange(0.0, t_end * (1 + 1e-12), frame_interval)
+    ckpt = load_checkpoint(out, config) if resume else None
+    # the frames written before the interruption, read before the folder's series reopen
+    old_frames = read_frames(out, bar.series_meshes()) if ckpt is not None else {}
     # every input checked: the results folder opens (results.json with the inputs, "running")
     folder = None
     if out is not None:
@@ -391,6 +380,11 @@ def run_taylor_bar(
     con = bar.contact
     rec = TaylorRecorder(bar, con.name, con.pair.slave.weights, ke0, folder, frames, progress)
     lam_history = MultiplierHistory("coupling:patch") if arlequin else None
+    saver = None
+    if folder is not None:
+        saver = CheckpointWriter(folder.path, checkpoint_interval, config, call, rec, lam_history)
+    if ckpt is not None:
+        saver.resume_from(ckpt, old_frames)
     n_samples = max(1, round(t_end / sample_interval))
     t_eval = np.linspace(0.0, t_end, n_samples + 1)[1:]
     logger.info("Taylor bar (%s): %d x %d fine cells, %s backend", model, n_r, n_z,
@@ -399,7 +393,9 @@ def run_taylor_bar(
     try:
         res = solve(bar.system, "explicit", t_end=t_end, v0=v0, constraints=[con],
                     step_controller=controller, t_eval=t_eval, on_record=[rec],
-                    on_step=[lam_history] if lam_history is not None else [])  # fmt: skip
+                    on_step=[lam_history] if lam_history is not None else [],
+                    on_checkpoint=saver,
+                    restore=None if ckpt is None else (ckpt["snapshot"], ckpt["recorder"]))
     except Exception as exc:
         if folder is not None:
             folder.finish("failed", str(exc))
@@ -469,5 +465,21 @@ def run_taylor_bar(
             logger.warning(msg)
     if folder is not None:
         write_results(folder, result, _RESULT_UNITS)
+    if saver is not None:
+        saver.remove()
     logger.info(result.summary())
     return result
+
+
+def resume_taylor_bar(out: str | Path, progress: Callable[[float], None] | None = None,
+                      ) -> TaylorBarResult:  # fmt: skip
+    """Continue the interrupted Taylor bar run of the results folder ``out`` from its last
+    checkpoint, with the inputs the checkpoint recorded (see :func:`run_taylor_bar`).
+
+    Raises
+    ------
+    ValueError
+        If ``out`` has no (readable) checkpoint.
+    """
+    call = load_checkpoint(out, None)["call"]
+    return run_taylor_bar(**call, out=out, progress=progress, resume=True)

@@ -17,7 +17,15 @@ from typing import Any
 import numpy as np
 import skfem
 
-__all__ = ["ArlequinBarSizes", "arlequin_bar_sizes", "graded_bar_mesh", "taylor_bar_mesh"]
+__all__ = [
+    "ArlequinBarSizes",
+    "arlequin_bar_sizes",
+    "elements_radial_of",
+    "fine_radial",
+    "graded_bar_mesh",
+    "positive",
+    "taylor_bar_mesh",
+]
 
 
 def taylor_bar_mesh(length: float, radius: float, elements_radial: int) -> skfem.MeshQuad:
@@ -225,3 +233,40 @@ def graded_bar_mesh(length: float, radius: float, sizes: ArlequinBarSizes) -> sk
     t = inverse.reshape(-1, 4).T
     p[0, np.abs(p[0] - radius) < 1e-9 * radius] = radius
     return skfem.MeshQuad(np.ascontiguousarray(p), np.ascontiguousarray(t))
+
+
+def positive(name: str, value: Any) -> float:
+    """``value`` as a float, or a ValueError naming ``name`` unless it is positive and finite."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.number)):
+        raise ValueError(f"{name} must be a number, got {name}={value!r}")
+    if not (math.isfinite(value) and value > 0.0):
+        raise ValueError(f"{name} must be positive and finite, got {name}={value}")
+    return float(value)
+
+
+def elements_radial_of(elements_radial, mesh_size, radius) -> int:
+    """Cells across the radius from ``elements_radial`` (default 10) or ``mesh_size`` (m)."""
+    if elements_radial is not None and mesh_size is not None:
+        raise ValueError(
+            f"give elements_radial or mesh_size, not both (got elements_radial={elements_radial}, "
+            f"mesh_size={mesh_size})"
+        )
+    if mesh_size is not None:
+        h = positive("mesh_size", mesh_size)
+        if h > radius:
+            raise ValueError(f"mesh_size must not exceed the radius {radius} m, got {h}")
+        return max(1, round(radius / h))
+    n = 10 if elements_radial is None else elements_radial
+    if isinstance(n, bool) or int(n) != n or n < 1:
+        raise ValueError(f"elements_radial must be a positive integer, got elements_radial={n}")
+    return int(n)
+
+
+def fine_radial(elements_radial, mesh_size, fine_size, radius) -> int:
+    """Fine cells across the radius from the three aliases (the Arlequin and graded models)."""
+    given = [(k, v) for k, v in (("elements_radial", elements_radial), ("mesh_size", mesh_size),
+                                 ("fine_size", fine_size)) if v is not None]  # fmt: skip
+    if len(given) > 1:
+        raise ValueError(f"give one of elements_radial, mesh_size or fine_size, got {dict(given)}")
+    size = fine_size if fine_size is not None else mesh_size
+    return elements_radial_of(elements_radial, size, radius)

@@ -118,6 +118,29 @@ class TaylorRecorder:
             self.progress(float(integ.t))
 
 
+    def state(self) -> dict[str, Any]:
+        """What the run has recorded so far (a checkpoint; see :meth:`restore`)."""
+        return {"history": {k: list(v) for k, v in self.history.items()},
+                "balance": list(self.balance), "next_frame": self._next_frame,
+                "last": self._last}  # fmt: skip
+
+    def restore(self, state: dict[str, Any], frames: dict[str, list]) -> None:
+        """Continue from a :meth:`state`: the history rows and the field frames written until
+        then (``frames``: series name -> [(t, point_data, cell_data)] read back from the
+        interrupted run's files) are written again, then the run appends to them."""
+        self.history = {k: list(v) for k, v in state["history"].items()}
+        self.balance = list(state["balance"])
+        self._next_frame = int(state["next_frame"])
+        self._last = state["last"]
+        if self.csv is not None:
+            for i, err in enumerate(self.balance):
+                self.csv.append({**{k: v[i] for k, v in self.history.items()},
+                                 "balance_error": err})  # fmt: skip
+        for name, series in self.series.items():
+            for t, point, cell in frames.get(name, [])[: self._next_frame]:
+                series.write(t, point, {k: v[0] for k, v in cell.items()})
+
+
 class MultiplierHistory:
     """Per-step multipliers of one mediator (an ``on_step`` listener), for the chatter check.
 

@@ -93,6 +93,8 @@ def solve(
     save_fields: bool = False,
     on_record: Sequence[Callable[[Integrator], None]] = (),
     on_step: Sequence[Callable[[Integrator], None]] = (),
+    on_checkpoint: Callable[[Integrator, Recorder], None] | None = None,
+    restore: Any = None,
     **options: Any,
 ) -> DynamicResult:
     """Integrate a coupled system in time.
@@ -133,6 +135,13 @@ def solve(
     on_step : sequence of callables
         ``listener(integrator)`` after every step, before any record of that step (cheap
         per-step monitors, e.g. a multiplier history; they must not change the integrator).
+    on_checkpoint : callable, optional
+        ``on_checkpoint(integrator, recorder)`` after each record and its listeners: where a
+        long run saves ``integrator.snapshot()`` and ``recorder.state()`` to resume from.
+    restore : tuple, optional
+        ``(snapshot, recorder_state)`` of a checkpoint: the run continues from the snapshot's
+        time with what was recorded until then (the same system, integrator, options, stops and
+        listeners as the interrupted run give the same steps and values bit for bit).
     **options
         Passed to the integrator class (``beta``, ``gamma``, ``alpha``, ``theta``, ``safety``,
         ``constraints``, ``consistent_initial``...).
@@ -185,11 +194,23 @@ def solve(
     if stops:
         integ.set_stops(stops)
     rec = Recorder(integ, save_fields, tuple(on_record))
-    rec.record()
-    if callback is not None and callback(integ):
-        return rec.result(1, "stopped by the callback at the initial state")
-    pending = list(times[times > t0]) if times is not None else None
-    k = 0
+    if restore is not None:
+        snapshot, recorder_state = restore
+        integ.restore(snapshot)
+        if stops:
+            integ.set_stops(stops)
+        rec.load_state(recorder_state)
+        t_start = integ.t
+    else:
+        rec.record()
+        if on_checkpoint is not None:
+            on_checkpoint(integ, rec)
+        if callback is not None and callback(integ):
+            return rec.result(1, "stopped by the callback at the initial state")
+        t_start = t0
+    pending = list(times[times > t_start + 1e-12 * float(integ.dt)]) if times is not None \
+        else None  # fmt: skip
+    k = integ.step_count
     verbose = logger.isEnabledFor(logging.INFO)
     next_log = time.perf_counter() + LOG_INTERVAL
     while True:
@@ -218,6 +239,8 @@ def solve(
             take = k % record_every == 0 or last
         if take:
             rec.record()
+            if on_checkpoint is not None:
+                on_checkpoint(integ, rec)
             if callback is not None and callback(integ):
                 return rec.result(1, f"stopped by the callback at step {k}, t = {integ.t:.6e} s")
     return rec.result(0, f"reached t = {integ.t:.6e} s in {integ.step_count} steps")

@@ -9,6 +9,7 @@ receive each record as it is taken, so that a results folder is written as the r
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Callable
 from typing import Any
 
@@ -48,6 +49,19 @@ class Recorder:
         self.us: list[np.ndarray] = []
         self.vs: list[np.ndarray] = []
         self.listeners = tuple(on_record)
+
+    #: The attributes that :meth:`state` saves (everything recorded so far).
+    _STATE = ("times", "rows", "mult", "iters", "sizes", "records", "us", "vs")
+
+    def state(self) -> dict[str, Any]:
+        """What has been recorded so far (a checkpoint of a run; restore it with
+        :meth:`load_state`)."""
+        return {name: copy.deepcopy(getattr(self, name)) for name in self._STATE}
+
+    def load_state(self, state: dict[str, Any]) -> None:
+        """Continue from a :meth:`state` (a resumed run)."""
+        for name in self._STATE:
+            setattr(self, name, copy.deepcopy(state[name]))
 
     def record(self) -> None:
         """Record the integrator's current state."""
