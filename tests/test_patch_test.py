@@ -10,6 +10,7 @@ multipliers) are the issue's acceptance bounds; measured values are 1e-15 to 5e-
 from __future__ import annotations
 
 import itertools
+import json
 import warnings
 
 import pytest
@@ -114,3 +115,13 @@ def test_constant_weights_warn_outside_condition_a():
     with pytest.warns(ExactnessWarning, match="constant weights"):
         r = run_patch_test(dim="2", weights="constant", mediator="coarse")
     assert not r.exact_expected
+
+
+@pytest.mark.parametrize("dim", ["1", "2"])
+def test_results_folder_has_the_error_field_picture(dim, tmp_path):
+    r = run_patch_test(dim=dim, out=tmp_path / "run")
+    assert r.max_error <= 1e-10  # exact configuration (see the tests above)
+    png = tmp_path / "run" / "patch_test_error.png"
+    assert png.stat().st_size > 0
+    meta = json.loads((tmp_path / "run" / "results.json").read_text())
+    assert meta["files"]["pictures"]["patch_test_error"] == "patch_test_error.png"

@@ -372,6 +372,13 @@ def run_patch_test(
         units = {"max_error": "1", "exact_residual": "1", "n_coarse_dofs": "1",
                  "n_fine_dofs": "1", "n_multipliers": "1"}  # fmt: skip
         folder.add_results(values, units)
+        from .plots import plot_patch_test_error
+
+        d = {"coarse": coarse_mesh, name: fine_mesh}
+        errors = {k: np.linalg.norm((result.displacements[k] - u_exact[k]).reshape(
+            -1, d[k].dim()), axis=1) / scale for k in d}  # fmt: skip
+        plot_patch_test_error(d, errors, str(folder.picture("patch_test_error")),
+                              out_result.summary())  # fmt: skip
         folder.finish()
     return out_result
 
