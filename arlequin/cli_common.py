@@ -93,6 +93,7 @@ class ProgressBar:
         self.bar = None
 
     def update(self, x: float) -> None:
+        """Show ``x`` (in the caller's unit, times ``scale``) as done."""
         if self.bar is None:
             from tqdm import tqdm
 
@@ -109,6 +110,7 @@ class ProgressBar:
         self.bar.refresh()
 
     def close(self) -> None:
+        """Close the bar (if it was opened)."""
         if self.bar is not None:
             self.bar.close()
 

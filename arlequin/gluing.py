@@ -437,6 +437,7 @@ class PatchCoupling:
         return BlockTerm(self.integration_model, weight, self.coarse_transfer, 1.0)
 
     def fine_term(self) -> BlockTerm:
+        """The patch model's term of its block, weighted by α_fine at its quadrature points."""
         return BlockTerm(self.fine_model, self.alpha_fine)
 
     def integration_boundary_facets(self) -> np.ndarray:

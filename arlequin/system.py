@@ -98,9 +98,11 @@ class BlockTerm:
         return self.sign * (p.T @ a @ p).tocsr()
 
     def stiffness(self) -> sp.csr_matrix:
+        """The term's weighted stiffness lifted to its block (N/m)."""
         return self._lift(self.model.stiffness(self.weight))
 
     def mass(self) -> sp.csr_matrix:
+        """The term's weighted consistent mass lifted to its block (kg)."""
         return self._lift(self.model.mass(self.weight, lumped=False))
 
 
@@ -166,6 +168,7 @@ class CoupledSystem:
         return self.dofmap.n_dofs
 
     def block(self, name: str) -> Block:
+        """The block named ``name``."""
         for b in self.blocks:
             if b.name == name:
                 return b
@@ -222,6 +225,7 @@ class CoupledSystem:
         return sp.vstack(rows, format="csr")
 
     def constraint_rhs(self, t: float, kinds: Sequence[str] | None = None) -> np.ndarray:
+        """The right-hand sides g(t) of the equality constraints at time ``t`` (s), stacked."""
         parts = [c.g(t) for c in self.constraints if kinds is None or c.kind in kinds]
         return np.concatenate(parts) if parts else np.zeros(0)
 

@@ -366,6 +366,8 @@ class LevelSetContact(_ContactConstraint):
     def update_status(
         self, trial: ContactTrial, u: np.ndarray, v: np.ndarray, multipliers: np.ndarray
     ) -> ContactTrial:
+        """New active statuses from the trial fields (the indicator fields S_d, S_v at the
+        collocation points); whether any changed."""
         lam = np.asarray(multipliers, dtype=float)
         vn = trial.geometry.rows @ v  # [[v_n]] with the step's rows
         used = trial.active
@@ -445,6 +447,8 @@ class SignoriniContact(_ContactConstraint):
     def update_status(
         self, trial: ContactTrial, u: np.ndarray, v: np.ndarray, multipliers: np.ndarray
     ) -> ContactTrial:
+        """New active statuses from the trial fields (the indicator fields S_d, S_v at the
+        collocation points), and whether any changed."""
         g = trial.geometry.rows
         lam = np.asarray(multipliers, dtype=float)
         gap = trial.gap_start + g @ (u - trial.u_start)

@@ -99,6 +99,7 @@ class TwoBarsResult(JsonResult):
         return impact_metrics(self)
 
     def summary(self) -> str:
+        """One line: the errors against the exact solution."""
         m = self.metrics()
         text = (
             f"{self.method} ({self.integrator}), dt = {self.dt:.4e} s: interface velocity rms "

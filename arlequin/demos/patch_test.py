@@ -58,6 +58,7 @@ class PatchTestResult(JsonResult):
     json_exclude = ("static",)
 
     def summary(self) -> str:
+        """One line: the configuration, the error and the residual of the exact solution."""
         return (
             f"patch test dim={self.dim} {self.mesh} {self.coupling} {self.weights} weights, "
             f"{self.mediator} mediator, seed {self.seed}: max_error={self.max_error:.3e}, "

@@ -66,6 +66,7 @@ class ArlequinBarSizes:
         self.gluing_width = band_rows * self.axial_size
 
     def as_dict(self) -> dict[str, Any]:
+        """The sizes as a dict (counts; lengths in m), for the results' inputs."""
         return {
             "coarse_radial": self.coarse_radial, "coarse_axial": self.coarse_axial,
             "ratio": self.ratio, "patch_rows": self.patch_rows, "band_rows": self.band_rows,

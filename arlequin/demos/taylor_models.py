@@ -111,14 +111,17 @@ class MonoBar:
         self.fine_weight = None
 
     def initial_velocity(self, velocity: float) -> np.ndarray:
+        """The system's initial velocity (m/s): −``velocity`` along z on every node."""
         v0 = np.zeros(self.system.dofmap.n_dofs)
         v0[self._z] = -velocity
         return v0
 
     def lumped_mass(self) -> np.ndarray:
+        """The lumped mass (kg per dof)."""
         return self.model.mass(lumped=True)
 
     def fine_state(self, integ) -> Any:
+        """The finite-strain model's quadrature state (``PlasticState``) in the integrator."""
         return integ.states["bar"][0]
 
     def measures(self, u: np.ndarray) -> tuple[float, float]:
@@ -138,9 +141,11 @@ class MonoBar:
         }
 
     def series_meshes(self) -> dict[str, Any]:
+        """Series name -> reference mesh of the field series the run writes."""
         return {"bar": self.mesh}
 
     def frame(self, integ) -> dict[str, tuple[dict, dict]]:
+        """Series name -> (point data, cell data) of one field frame at the integrator's time."""
         u, v, state = integ.u, integ.v, self.fine_state(integ)
         pad = np.zeros(self.mesh.nvertices)
         point = {
@@ -154,9 +159,11 @@ class MonoBar:
         return {"bar": (point, cell)}
 
     def fine_displacement(self, u: np.ndarray) -> np.ndarray:
+        """The finite-strain model's part of the system's displacement ``u`` (m)."""
         return u
 
     def render(self, u, state, path: str, title: str) -> None:
+        """The picture of the final state (PNG at ``path``), pyvista off-screen."""
         from .render import render_taylor_bar
 
         render_taylor_bar(self.model, u, state, path, title)
@@ -234,6 +241,7 @@ class ArlequinBar:
         self.patch_fraction = s.patch_rows / s.coarse_axial
 
     def initial_velocity(self, velocity: float) -> np.ndarray:
+        """The system's initial velocity (m/s): −``velocity`` along z on every node."""
         v0 = np.zeros(self.system.dofmap.n_dofs)
         v0[self._cz] = -velocity
         v0[self._fz] = -velocity
@@ -244,9 +252,11 @@ class ArlequinBar:
         return np.asarray(self.system.mass(lumped=True))
 
     def fine_state(self, integ) -> Any:
+        """The finite-strain model's quadrature state (``PlasticState``) in the integrator."""
         return integ.states["patch"][0]
 
     def fine_displacement(self, u: np.ndarray) -> np.ndarray:
+        """The finite-strain model's part of the system's displacement ``u`` (m)."""
         return u[self._f]
 
     def measures(self, u: np.ndarray) -> tuple[float, float]:
@@ -271,9 +281,11 @@ class ArlequinBar:
         }
 
     def series_meshes(self) -> dict[str, Any]:
+        """Series name -> reference mesh of the field series the run writes."""
         return {"coarse": self.coarse_mesh, "patch": self.fine_mesh}
 
     def frame(self, integ) -> dict[str, tuple[dict, dict]]:
+        """Series name -> (point data, cell data) of one field frame at the integrator's time."""
         frames = self.layout.frame(self.system.dofmap, integ.u, integ.v, integ.multipliers)
         state = self.fine_state(integ)
         frames["patch"][1]["plastic_strain"] = state.eqps.mean(axis=1)
@@ -285,6 +297,7 @@ class ArlequinBar:
         return float(np.asarray(state.eqps)[self.band_cells].max())
 
     def render(self, u, state, path: str, title: str) -> None:
+        """The picture of the final state (PNG at ``path``), pyvista off-screen."""
         from .render import render_arlequin_bar
 
         render_arlequin_bar(self, u, state, path, title)

@@ -143,6 +143,7 @@ class TaylorBarResult(JsonResult):
     json_exclude = ("model", "u", "state", "setup", "arlequin", "multiplier_history")
 
     def to_json(self) -> dict[str, Any]:
+        """The JSON document: the interface keys first, then the Arlequin ones, then the rest."""
         data = super().to_json()
         # the Interface keys first, then the Arlequin ones (flat), then the rest
         extra = {k: jsonable(v) for k, v in (self.arlequin or {}).items()}

@@ -94,6 +94,7 @@ class WaveResult(JsonResult):
     )
 
     def summary(self) -> str:
+        """One line: the reflected and transmitted energy fractions."""
         c = self.config
         return (
             f"wave ratio {c.get('ratio')} W={c.get('pulse_width')} G={c.get('gluing_width')} "

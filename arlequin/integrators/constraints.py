@@ -149,11 +149,14 @@ class LinearInequality:
 
     # ------------------------------------------------------------------ protocol
     def initial_state(self, u: np.ndarray, v: np.ndarray) -> InequalityState:
+        """The state at the start of a run (all rows inactive)."""
         return InequalityState(np.zeros(self.n_rows, dtype=bool))
 
     def begin_step(
         self, state: InequalityState, t: float, dt: float, u: np.ndarray, v: np.ndarray
     ) -> InequalityTrial:
+        """The trial of a step of size ``dt`` (s) from ``t`` (see
+        :class:`arlequin.contract.UnilateralConstraint`)."""
         bound = self.bound(t + dt)  # at the end of the step
         if self.level == "velocity":
             # S_d: the gap predicted with the step's free velocity, fixed during the iterations
@@ -166,6 +169,8 @@ class LinearInequality:
     def update_status(
         self, trial: InequalityTrial, u: np.ndarray, v: np.ndarray, multipliers: np.ndarray
     ) -> InequalityTrial:
+        """New active statuses from the trial displacement, velocity and multipliers, and
+        whether they changed."""
         old = trial.active
         lam = np.asarray(multipliers, dtype=float)
         if self.level == "displacement":
@@ -188,5 +193,7 @@ class LinearInequality:
         multipliers: np.ndarray,
         impulse: np.ndarray,
     ) -> InequalityState:
+        """The state after an accepted step (see
+        :class:`arlequin.contract.UnilateralConstraint`)."""
         work = -0.5 * float(impulse @ (self._g @ (v_before + v_after)))
         return InequalityState(trial.active.copy(), state.work + work)

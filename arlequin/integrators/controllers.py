@@ -65,6 +65,7 @@ class FixedStep:
         check_step(self.dt)
 
     def propose(self, integrator: Any) -> float:
+        """The next step size (s) for ``integrator``."""
         return float(self.dt)
 
 
@@ -98,6 +99,7 @@ class CriticalFraction:
             raise ValueError(f"every must be a positive integer, got every={self.every}")
 
     def propose(self, integrator: Any) -> float:
+        """The next step size (s) for ``integrator``."""
         return self.safety * float(integrator.critical_time_step(max_age=int(self.every)))
 
 
@@ -126,6 +128,7 @@ class StepSchedule:
             )
 
     def propose(self, integrator: Any) -> float:
+        """The next step size (s) for ``integrator``."""
         return check_step(self.schedule(integrator), "scheduled time step")
 
 

@@ -69,6 +69,7 @@ class SaddlePoint:
         return int(self.free.size)
 
     def full_displacement(self, u_free: np.ndarray) -> np.ndarray:
+        """The displacement on every dof (m) from the free dofs' values ``u_free``."""
         u = np.zeros(self.free.size + self.fixed.size)
         u[self.free] = u_free
         u[self.fixed] = self.fixed_values

@@ -81,12 +81,15 @@ class JsonResult:
     json_exclude: tuple[str, ...] = ()
 
     def to_json(self) -> dict[str, Any]:
+        """The result as JSON values: the fields of ``json_keys`` (default all but
+        ``json_exclude``)."""
         keys = self.json_keys
         if keys is None:
             keys = tuple(k for k in self.__dataclass_fields__ if k not in self.json_exclude)
         return {k: jsonable(getattr(self, k)) for k in keys}
 
     def dumps(self) -> str:
+        """The JSON document as indented text."""
         return json.dumps(self.to_json(), indent=2)
 
 

@@ -46,6 +46,7 @@ class HistoryCSV:
         self.n_rows += 1
 
     def close(self) -> None:
+        """Close the file (every row is already on disk)."""
         if not self._fh.closed:
             self._fh.close()
 
