@@ -144,8 +144,7 @@ def _add_two_bars(sub) -> None:
 def _cmd_wave(args: argparse.Namespace) -> int:
     from .demos.wave import plot_wave, run_wave
 
-    bar, update = progress_bar(100.0, "%", args.quiet, scale=100.0, label="coupled run")
-    try:
+    with progress_bar(100.0, "%", args.quiet, scale=100.0, label="coupled run") as update:
         result = run_wave(
             ratio=args.ratio,
             pulse_width=args.pulse_width,
@@ -158,9 +157,6 @@ def _cmd_wave(args: argparse.Namespace) -> int:
             out=args.out,
             progress=update,
         )
-    finally:
-        if bar is not None:
-            bar.close()
     print(result.summary())
     _write_json(args.json, result.to_json())
     if args.plot:

@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import math
 import os
+from collections.abc import Callable, Iterator
 
 __all__ = [
     "NonFiniteResult",
@@ -115,11 +117,16 @@ class ProgressBar:
             self.bar.close()
 
 
+@contextlib.contextmanager
 def progress_bar(total: float, unit: str, quiet: bool, scale: float = 1.0,
-                 label: str = "progress"):  # fmt: skip
-    """(bar, update): a lazily opened :class:`ProgressBar` and its update, or (None, None) when
-    ``quiet``."""
+                 label: str = "progress") -> Iterator[Callable[[float], None] | None]:  # fmt: skip
+    """``with progress_bar(...) as update:`` a lazily opened :class:`ProgressBar` (``update``
+    its update; None when ``quiet``), closed on leaving the block, whatever happens in it."""
     if quiet:
-        return None, None
+        yield None
+        return
     bar = ProgressBar(total, unit, scale, label)
-    return bar, bar.update
+    try:
+        yield bar.update
+    finally:
+        bar.close()

@@ -27,12 +27,9 @@ def _cmd_resume(args: argparse.Namespace) -> int:
     if args.out is None:
         raise ValueError("--resume needs --out DIR, the results folder of the interrupted run")
     t_end = load_checkpoint(args.out, None)["call"]["t_end"]
-    bar, update = progress_bar(t_end * 1e6, "µs", args.quiet, scale=1e6, label="simulated time")
-    try:
+    with progress_bar(t_end * 1e6, "µs", args.quiet, scale=1e6,
+                      label="simulated time") as update:  # fmt: skip
         result = resume_taylor_bar(args.out, progress=update)
-    finally:
-        if bar is not None:
-            bar.close()
     print(result.summary())
     write_json(args.json, result.to_json())
     return 0
@@ -43,19 +40,15 @@ def _cmd_taylor_bar(args: argparse.Namespace) -> int:
 
     if args.resume:
         return _cmd_resume(args)
-    law_params = {
-        k: getattr(args, k)
-        for k in ("voce_saturation", "voce_rate", "jc_b", "jc_n", "jc_c", "jc_reference_rate")
-    }
-    law_params = {k: v for k, v in law_params.items() if v is not None}
-    bar, update = progress_bar(args.t_end * 1e6, "µs", args.quiet, scale=1e6,
-                               label="simulated time")  # fmt: skip
+    laws = ("voce_saturation", "voce_rate", "jc_b", "jc_n", "jc_c", "jc_reference_rate")
+    law_params = {k: getattr(args, k) for k in laws if getattr(args, k) is not None}
     # the Arlequin options given on the command line (run_taylor_bar refuses those that do not
     # apply to the model, before any work)
     names = ("patch_length", "gluing_width", "coarse_size", "fine_size", "weights", "mediator",
              "coupling", "coarse_step_ratio", "band_warning")  # fmt: skip
     arlequin = {k: getattr(args, k) for k in names if getattr(args, k) is not None}
-    try:
+    with progress_bar(args.t_end * 1e6, "µs", args.quiet, scale=1e6,
+                      label="simulated time") as update:  # fmt: skip
         result = run_taylor_bar(
             model=args.model,
             elements_radial=args.elements_radial,
@@ -78,9 +71,6 @@ def _cmd_taylor_bar(args: argparse.Namespace) -> int:
             **arlequin,
             **law_params,
         )
-    finally:
-        if bar is not None:
-            bar.close()
     print(result.summary())
     write_json(args.json, result.to_json())
     return 0

@@ -91,7 +91,7 @@ def render_arlequin_bar(bar: Any, u: np.ndarray, state: Any, path: str, title: s
     z_band = s.patch_length - s.gluing_width
     zone = np.where(z_mid > s.patch_length, 0.0, np.where(z_mid > z_band, 1.0, 2.0))
     eqps = np.asarray(state.eqps).mean(axis=1)
-    uc, uf = u[bar._c], u[bar._f]
+    uc, uf = bar.split(u)
     plotter = pv.Plotter(off_screen=True, shape=(1, 2), window_size=(1400, 1000))
     bar_args = {"color": "black", "title": "plastic strain (cell mean)",
                 "vertical": True, "position_x": 0.72, "position_y": 0.25, "height": 0.5,

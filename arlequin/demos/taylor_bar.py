@@ -346,7 +346,7 @@ def run_taylor_bar(
         n_z = sizes.patch_rows * sizes.ratio
         config.update(weights=str(weights), mediator=mediator, coupling=coupling,
                       coarse_step_ratio=int(coarse_step_ratio), band_warning=band_warning,
-                      epsilon=1e-3)  # fmt: skip
+                      epsilon=bar.problem.patches[0].epsilon)  # fmt: skip
     else:
         bar = MonoBar(length, radius, n_r, material, fbar, backend, visc)
         n_z = bar.mesh.t.shape[1] // n_r
@@ -462,7 +462,6 @@ def run_taylor_bar(
                    f"{band_warning} (band_warning): the coarse model glued there is elastic; "
                    f"lengthen the patch (patch_length={s.patch_length:.4g} m)")  # fmt: skip
             warnings.warn(msg, GluingBandPlasticityWarning, stacklevel=2)
-            logger.warning(msg)
     if folder is not None:
         write_results(folder, result, _RESULT_UNITS)
     if saver is not None:

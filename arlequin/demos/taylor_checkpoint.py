@@ -67,7 +67,7 @@ class CheckpointWriter:
             "format": _FORMAT, "t": t, "config": self.config, "call": self.call,
             "snapshot": integ.snapshot(), "recorder": recorder.state(),
             "taylor": self.taylor.state(),
-            "multipliers": None if self.multipliers is None else list(self.multipliers._rows),
+            "multipliers": None if self.multipliers is None else self.multipliers.state(),
         }  # fmt: skip
         tmp = self.path.with_suffix(".tmp")
         try:
@@ -88,7 +88,7 @@ class CheckpointWriter:
         checkpoint is the one after it."""
         self.taylor.restore(ckpt["taylor"], frames)
         if self.multipliers is not None:
-            self.multipliers._rows = list(ckpt["multipliers"])
+            self.multipliers.restore(ckpt["multipliers"])
         self.next_time = (int(ckpt["t"] / self.interval + 1e-9) + 1) * self.interval
 
     def remove(self) -> None:

@@ -108,7 +108,6 @@ class MonoBar:
         self._face = np.nonzero(p[1] < tol)[0]
         self._r, self._z = dofs[0], dofs[1]
         self.n_elements = int(mesh.nelements)
-        self.fine_weight = None
 
     def initial_velocity(self, velocity: float) -> np.ndarray:
         """The system's initial velocity (m/s): −``velocity`` along z on every node."""
@@ -129,8 +128,9 @@ class MonoBar:
         x = self.model.current_coordinates(u)
         return float(x[1, self._axis_top]), float(x[0, self._face].max())
 
-    def energies(self, integ) -> dict[str, float]:
-        """Stored (elastic), plastic and viscous energies and the coupling work (J)."""
+    def energies(self, integ, e: dict) -> dict[str, float]:
+        """Stored (elastic), plastic and viscous energies and the coupling work (J); ``e`` is
+        ``integ.energies()`` (unused on one mesh)."""
         state = self.fine_state(integ)
         u = integ.u
         return {
@@ -157,10 +157,6 @@ class MonoBar:
             "von_mises": state.von_mises.mean(axis=1),
         }
         return {"bar": (point, cell)}
-
-    def fine_displacement(self, u: np.ndarray) -> np.ndarray:
-        """The finite-strain model's part of the system's displacement ``u`` (m)."""
-        return u
 
     def render(self, u, state, path: str, title: str) -> None:
         """The picture of the final state (PNG at ``path``), pyvista off-screen."""
@@ -216,7 +212,6 @@ class ArlequinBar:
         self.system = self.problem.system()
         self.coupling = self.problem.couplings[0]
         self.layout = self.problem.field_layout()
-        self.fine_weight = self.coupling.alpha_fine
         dm = self.system.dofmap
         # the wall's lateral reach stays below the gluing band
         lateral = min(LATERAL_CONTACT * length, s.patch_length - s.gluing_width)
@@ -255,24 +250,24 @@ class ArlequinBar:
         """The finite-strain model's quadrature state (``PlasticState``) in the integrator."""
         return integ.states["patch"][0]
 
-    def fine_displacement(self, u: np.ndarray) -> np.ndarray:
-        """The finite-strain model's part of the system's displacement ``u`` (m)."""
-        return u[self._f]
+    def split(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The coarse and the patch parts of a system vector ``u``."""
+        return u[self._c], u[self._f]
 
     def measures(self, u: np.ndarray) -> tuple[float, float]:
         """(length from the coarse model's top node on the axis, footprint radius from the
         patch's impact face) (m)."""
-        uc, uf = u[self._c], u[self._f]
+        uc, uf = self.split(u)
         length = self.coarse_mesh.p[1, self._axis_top] + uc[2 * self._axis_top + 1]
         r = self.fine_mesh.p[0, self._face] + uf[2 * self._face]
         return float(length), float(r.max())
 
-    def energies(self, integ) -> dict[str, float]:
-        """Weighted energies of both models and the net work of the coupling forces (J)."""
+    def energies(self, integ, e: dict) -> dict[str, float]:
+        """Weighted energies of both models and the net work of the coupling forces (J);
+        ``e`` is ``integ.energies()``."""
         state = self.fine_state(integ)
         uf = integ.u[self._f]
-        e = integ.energies()
-        alpha = self.fine_weight
+        alpha = self.coupling.alpha_fine
         return {
             "elastic": e["strain"]["coarse"] + self.model.stored_energy(uf, state, alpha),
             "plastic_dissipation": self.model.plastic_dissipation(state, alpha),

@@ -41,7 +41,7 @@ class TaylorRecorder:
     ----------
     bar : MonoBar or ArlequinBar
         The view of the models (:mod:`arlequin.demos.taylor_models`): ``measures(u)``,
-        ``energies(integ)``, ``series_meshes()``, ``frame(integ)``.
+        ``energies(integ, integ.energies())``, ``series_meshes()``, ``frame(integ)``.
     con_name : str
         The wall constraint's name.
     weights : ndarray
@@ -74,8 +74,9 @@ class TaylorRecorder:
         if self.loop_start is None:
             self.loop_start = time.perf_counter()
         length, radius = self.bar.measures(integ.u)
-        kinetic = float(sum(integ.energies()["kinetic"].values()))
-        parts = self.bar.energies(integ)
+        energies = integ.energies()
+        kinetic = float(sum(energies["kinetic"].values()))
+        parts = self.bar.energies(integ, energies)
         cstate = integ.constraint_states[self.con_name]
         wc = -float(cstate.work)
         # λ is the nominal pressure (Pa) at the collocation points (≤ 0 in compression): the
@@ -157,6 +158,14 @@ class MultiplierHistory:
         lam = integ.multipliers.get(self.name)
         if lam is not None:
             self._rows.append(np.asarray(lam, dtype=np.float32).copy())
+
+    def state(self) -> list[np.ndarray]:
+        """The rows recorded so far (a checkpoint)."""
+        return list(self._rows)
+
+    def restore(self, rows: list[np.ndarray]) -> None:
+        """Continue from a :meth:`state`."""
+        self._rows = list(rows)
 
     def array(self) -> np.ndarray:
         """(n_steps, n_rows) multipliers, one row per step."""
