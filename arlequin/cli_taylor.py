@@ -155,7 +155,7 @@ def add_taylor_bar(sub) -> None:
         type=int,
         default=None,
         metavar="M",
-        help="arlequin: coarse steps per patch step (only 1 is implemented so far)",
+        help="arlequin: multi-time-step, at most M patch steps per coarse step (default 1)",
     )
     p.add_argument(
         "--band-warning",

@@ -17,7 +17,11 @@ graded``), and prints their wall times, the ratios T_arlequin / T_uniform agains
 three quantities of interest of each and the process's peak memory after each run.
 
     python benchmarks/taylor_bar.py [--levels 5 10 20 30] [--plain 10 20] [--window 1e-6]
-    python benchmarks/taylor_bar.py --compare 20
+    python benchmarks/taylor_bar.py --compare 20 [--coarse-step-ratio 4]
+
+With ``--coarse-step-ratio M`` the Arlequin bar is also run with the multi-time-step scheme
+(the coarse model's force every m ≤ M fine steps): its wall time, the gain over the one-step
+run, its results and energy balance error beside the others.
 """
 
 from __future__ import annotations
@@ -79,7 +83,7 @@ def _qoi(r) -> dict:
     }
 
 
-def compare(n: int, coarse_size: float | None = None) -> dict:
+def compare(n: int, coarse_size: float | None = None, ratio_mts: int = 1) -> dict:
     """Arlequin against the uniform fine mesh, in this process (see the module docstring)."""
     import warnings
 
@@ -88,6 +92,10 @@ def compare(n: int, coarse_size: float | None = None) -> dict:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", GluingBandPlasticityWarning)
         arl = run_taylor_bar(model="arlequin", elements_radial=n, coarse_size=coarse_size)
+    mts = None
+    if ratio_mts > 1:
+        mts = run_taylor_bar(model="arlequin", elements_radial=n, coarse_size=coarse_size,
+                             coarse_step_ratio=ratio_mts)  # fmt: skip
     uni = run_taylor_bar(model="mono", elements_radial=n)
     graded = run_taylor_bar(model="graded", elements_radial=n)
     a = arl.arlequin
@@ -113,6 +121,17 @@ def compare(n: int, coarse_size: float | None = None) -> dict:
         "max_plastic_strain_difference": round(arl.max_plastic_strain / uni.max_plastic_strain
                                                - 1, 5),
     }  # fmt: skip
+    if mts is not None:
+        m = mts.arlequin
+        out["multi_time_step"] = {
+            **_qoi(mts), "coarse_step_ratio": ratio_mts, "mean_step_ratio":
+            round(m["mean_step_ratio"], 3), "macro_steps": m["macro_steps"],
+            "gain_T_one_step/T_mts": round(arl.wall_time_s / mts.wall_time_s, 4),
+            "length_difference_vs_one_step": round(mts.final_length / arl.final_length - 1, 6),
+            "radius_difference_vs_one_step": round(mts.mushroom_radius / arl.mushroom_radius - 1,
+                                                   6),
+            "multiplier_chatter": round(m["multiplier_chatter"], 4),
+        }  # fmt: skip
     return out
 
 
@@ -127,6 +146,8 @@ def main(argv: list[str] | None = None) -> int:
                         help="Arlequin vs the uniform mesh, N fine cells across")  # fmt: skip
     parser.add_argument("--coarse-size", type=float, default=None,
                         help="with --compare: the Arlequin coarse size (m)")  # fmt: skip
+    parser.add_argument("--coarse-step-ratio", type=int, default=1, metavar="M",
+                        help="with --compare: also the Arlequin run with multi-time-step M")
     parser.add_argument("--single", type=int, default=None, help=argparse.SUPPRESS)
     parser.add_argument("--no-fbar", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
@@ -134,7 +155,7 @@ def main(argv: list[str] | None = None) -> int:
         from arlequin.models.j2_kernel import warm_up
 
         warm_up()
-        out = compare(args.compare, args.coarse_size)
+        out = compare(args.compare, args.coarse_size, args.coarse_step_ratio)
         print(json.dumps({"benchmark": "taylor_bar_compare", **out}, indent=2))
         return 0
     if args.single is not None:

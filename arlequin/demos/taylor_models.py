@@ -185,6 +185,7 @@ class ArlequinBar:
     """
 
     fine_block = "patch"
+    coarse_block = "coarse"
 
     def __init__(self, length, radius, sizes: ArlequinBarSizes, material: J2Material,
                  weights="ramp", mediator="fine", coupling="H1", epsilon=1e-3, fbar=True,

@@ -9,6 +9,8 @@ Dynamic integrators (see ``docs/dynamics.md``), selected by name or class throug
 ``"newmark"``               :class:`Newmark` (β, γ) on the monolithic saddle point
 ``"hht"``                   :class:`HHTAlpha`: Newmark with numerical damping
 ``"theta"``                 :class:`ThetaScheme`: θ-scheme on (u, v)
+``"explicit-mts"``          :class:`SubcycledCentralDifference`: multi-time-step central
+                            differences, slow blocks with a macro step of m fine steps
 ==========================  ===============================================================
 
 Step sizes come from a step controller (:class:`FixedStep`, :class:`CriticalFraction`,
@@ -17,9 +19,10 @@ are :class:`arlequin.system.LinearConstraint`; unilateral rows (contact) follow
 :class:`arlequin.contract.UnilateralConstraint` (:class:`LinearInequality` is the minimal one).
 
 One concept a module: ``operators`` (mass, forces, tangents), ``rows`` (constraint rows),
-``linalg`` (factorisations), ``controllers`` (step sizes), ``base`` (the :class:`Integrator`
-class), ``registry``, ``explicit``, ``implicit``, ``stability``, ``recorder``, ``result``,
-``driver`` (:func:`solve`), ``static``, ``loads``.
+``linalg`` (factorisations), ``impulses`` (the explicit impulse solve), ``controllers`` (step
+sizes), ``base`` (the :class:`Integrator` class), ``registry``, ``explicit``, ``subcycling``,
+``implicit``, ``stability``, ``recorder``, ``result``, ``driver`` (:func:`solve`), ``static``,
+``loads``.
 """
 
 from ..contract import ConstraintError, SimulationError, UnilateralConstraint
@@ -36,6 +39,7 @@ from .registry import REGISTRY, get_integrator, register
 from .result import DynamicResult
 from .stability import DEFAULT_SAFETY, StableStep, check_time_step, stable_time_step
 from .static import SingularSystemError, StaticResult, solve_static
+from .subcycling import SubcycledCentralDifference
 
 __all__ = [
     "DEFAULT_SAFETY",
@@ -63,6 +67,7 @@ __all__ = [
     "StaticResult",
     "StepController",
     "StepSchedule",
+    "SubcycledCentralDifference",
     "SystemOperators",
     "Tabulated",
     "ThetaScheme",

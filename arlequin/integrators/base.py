@@ -122,6 +122,8 @@ class Integrator:
 
     name = "base"
     lumped_default = False
+    #: Whether the scheme applies the trials' prescribed multipliers (``applied``, slip friction).
+    applies_multipliers = False
 
     def __init__(
         self,
@@ -154,6 +156,12 @@ class Integrator:
         self.unilateral: list[UnilateralConstraint] = [
             c for c in all_constraints if is_unilateral(c)
         ]
+        for c in self.unilateral:
+            if getattr(c, "explicit_only", False) and not self.applies_multipliers:
+                raise ValueError(
+                    f"constraint {c.name!r} prescribes multipliers (slip friction): it runs "
+                    f"with the explicit integrator, not {self.name!r}"
+                )
         self.rows = EqualityRows([c for c in all_constraints if not is_unilateral(c)], self.ops)
         names = [c.name for c in self.unilateral] + list(self.rows.slices)
         if len(set(names)) != len(names):
@@ -210,6 +218,10 @@ class Integrator:
     def _step_impl(self) -> None:
         """Advance from t by self.dt; commit t, u, v, a, states; set the next self.dt."""
         raise NotImplementedError
+
+    def _phase_advanced(self) -> None:
+        """Called once a step is committed, before the next step size is chosen (a
+        multi-time-step scheme counts its fine steps here)."""
 
     def _step_size_changed(self) -> None:
         """Called after :meth:`set_step_size` changed the next step (explicit: redo the

@@ -41,119 +41,19 @@ import time
 from typing import Any
 
 import numpy as np
-import scipy.linalg as sla
 import scipy.sparse as sp
 
-from ..contract import ConstraintError, SimulationError, capabilities
+from ..contract import SimulationError, capabilities
 from .base import Integrator
 from .controllers import FixedStep, StepController
-from .linalg import factor_checked
+from .impulses import ImpulseSolver
 from .registry import register
-from .rows import rows_key, unilateral_block_power
+from .rows import unilateral_block_power
 from .stability import DEFAULT_SAFETY, StableStep, check_time_step, stable_time_step
 
 __all__ = ["DEFAULT_SAFETY", "CentralDifference"]
 
 logger = logging.getLogger(__name__)
-
-
-class _ImpulseSolver:
-    """Solves (B M⁻¹ Bᵀ) Λ = r for the equality rows E plus the active unilateral rows A.
-
-    The equality block S_EE is factorised once; active rows enter by a Schur complement
-    (dense, cached for the last active rows, keyed by their content), or by a sparse
-    factorisation of the whole matrix when there are many of them.
-    """
-
-    _DENSE_SCHUR = 300
-
-    def __init__(self, rows, inv_mass: np.ndarray) -> None:
-        self.rows = rows
-        self.inv_mass = inv_mass
-        self.m_e = rows.m
-        if self.m_e:
-            bj = rows.matrix_cols
-            s = (bj @ sp.diags(inv_mass[rows.cols]) @ bj.T).tocsc()
-            self.s_ee = s
-            self.lu = factor_checked(
-                s, "the impulse matrix B M⁻¹ Bᵀ of the equality rows", rows.row_name, spd=True
-            )
-        else:
-            self.s_ee = None
-            self.lu = None
-        self._cache: dict[Any, Any] = {}
-        self._last_key: tuple[Any, bytes] | None = None
-        self._eq_mask = np.zeros(inv_mass.size, dtype=bool)
-        if self.m_e:
-            self._eq_mask[rows.cols] = True
-
-    def solve_equality(self, r: np.ndarray) -> np.ndarray:
-        return self.lu.solve(r) if self.m_e else np.zeros(0)
-
-    def _cached(self, key: bytes, build):
-        fac = self._cache.get(key)
-        if fac is None:
-            fac = build()
-            self._cache = {key: fac}
-        return fac
-
-    def _key(self, g_a: sp.csr_matrix) -> bytes:
-        last = self._last_key
-        if last is not None and last[0] is g_a:  # the same stacked rows as last time
-            return last[1]
-        key = rows_key(g_a)
-        self._last_key = (g_a, key)
-        return key
-
-    def solve(self, r_e: np.ndarray, g_a: sp.csr_matrix, r_a: np.ndarray):
-        """Return (Λ_E, Λ_A) for right-hand sides r_e (m_E,), r_a (m_A,) and active rows g_a."""
-        m_a = g_a.shape[0]
-        if m_a == 0:
-            return self.solve_equality(r_e), np.zeros(0)
-        key = self._key(g_a)
-        minv = self.inv_mass
-        if self.m_e and not self._eq_mask[g_a.indices].any():
-            # no dof shared with the equality rows (a wall and a symmetry axis): two blocks
-            def build_aa_only():
-                s_aa = (g_a @ sp.diags(minv) @ g_a.T).tocsr()
-                return factor_checked(s_aa, "the impulse matrix of the active rows", spd=True)
-
-            return self.solve_equality(r_e), self._cached(key, build_aa_only).solve(r_a)
-        if self.m_e == 0:
-
-            def build_aa():
-                s_aa = (g_a @ sp.diags(minv) @ g_a.T).tocsr()
-                return factor_checked(s_aa, "the impulse matrix of the active rows", spd=True)
-
-            return np.zeros(0), self._cached(key, build_aa).solve(r_a)
-        s_ae = (g_a @ sp.diags(minv) @ self.rows.matrix.T).tocsr()
-        if m_a <= self._DENSE_SCHUR:
-
-            def build_schur():
-                s_aa = (g_a @ sp.diags(minv) @ g_a.T).tocsr()
-                x = self.lu.solve(s_ae.T.toarray()) if s_ae.nnz else np.zeros((self.m_e, m_a))
-                schur = s_aa.toarray() - s_ae @ x
-                try:
-                    cho = sla.cho_factor(schur)
-                except np.linalg.LinAlgError as exc:
-                    raise ConstraintError(
-                        "active unilateral rows are dependent on each other or on the equality "
-                        f"rows ({m_a} active rows)"
-                    ) from exc
-                return x, cho
-
-            x, cho = self._cached(key, build_schur)
-            y = self.lu.solve(r_e)
-            lam_a = sla.cho_solve(cho, r_a - s_ae @ y)
-            return y - x @ lam_a, lam_a
-
-        def build_full():
-            s_aa = (g_a @ sp.diags(minv) @ g_a.T).tocsr()
-            full = sp.bmat([[self.s_ee, s_ae.T], [s_ae, s_aa]], format="csc")
-            return factor_checked(full, "the impulse matrix with the active rows", spd=True)
-
-        sol = self._cached(key, build_full).solve(np.concatenate([r_e, r_a]))
-        return sol[: self.m_e], sol[self.m_e :]
 
 
 @register("explicit", "central_difference", "central-difference")
@@ -186,6 +86,7 @@ class CentralDifference(Integrator):
 
     name = "explicit"
     lumped_default = True
+    applies_multipliers = True
 
     def __init__(
         self,
@@ -205,21 +106,21 @@ class CentralDifference(Integrator):
         self.stable_method = stable_method
         self.check_dt = bool(check_dt)
         self.stable_step: StableStep | None = None
-        self._solver: _ImpulseSolver | None = None
+        self._solver: ImpulseSolver | None = None
         self._model_steps0: dict[tuple[int, int], float] = {}
         self._critical_now: float | None = None
         self._critical_at: int | None = None
         self._impulse_failed = False
+        self._f_applied: np.ndarray | None = None
         self.constraint_time = 0.0
         super().__init__(system, dt, **kwargs)
 
     # ------------------------------------------------------------------ stable step
-    def _impulse_solver(self) -> _ImpulseSolver:
+    def _impulse_solver(self) -> ImpulseSolver:
         if self._solver is None:
-            self._solver = _ImpulseSolver(self.rows, self.ops.inv_mass)
+            self._solver = ImpulseSolver(self.rows, self.ops.inv_mass)
             self._minv_cols = self.ops.inv_mass[self.rows.cols]
-            self._no_rows = sp.csr_matrix((0, self.ops.n))
-            self._no_lam = np.zeros(0)
+            self._no_rows, self._no_lam = sp.csr_matrix((0, self.ops.n)), np.zeros(0)
         return self._solver
 
     def _stable(self) -> StableStep:
@@ -332,9 +233,17 @@ class CentralDifference(Integrator):
         trials = self._begin_unilateral(t, dt, u, v_star)
         converged = False
         it = 0
+        v_free, r_e0 = v_star, r_e
         while it < self.max_status_iterations:
             it += 1
             g_a, rhs_a, idx, disp = self._active(trials)
+            # prescribed multipliers of inactive rows (slip friction): a force during the step
+            applied = [getattr(tr, "applied", None) for tr in trials]
+            f_app = self._applied_force(trials, applied)
+            v_star, r_e = v_free, r_e0
+            if f_app is not None:
+                v_star = v_free + dt_bar * minv * f_app
+                r_e = self._rhs_equality(v_star, u, t_next) if rows.m else r_e0
             w_a = np.where(disp, (rhs_a - g_a @ u) / dt, rhs_a)
             r_a = g_a @ v_star - w_a
             lam_e, lam_a = solver.solve(r_e, g_a, r_a)
@@ -344,6 +253,9 @@ class CentralDifference(Integrator):
             if g_a.shape[0]:
                 v_new -= minv * (g_a.T @ lam_a)
             fulls = self._full_multipliers(lam_a / dt_bar, idx)
+            if f_app is not None:
+                fulls = [f if a is None else f + a for f, a in zip(fulls, applied)]
+            self._f_applied = f_app
             trials, changed = self._update_statuses(trials, u + dt * v_new, v_new, fulls)
             if not changed:
                 converged = True
@@ -355,13 +267,22 @@ class CentralDifference(Integrator):
             self._status_cap_reached(t_next)
         return lam_e, lam_a, fulls, g_a, v_new, trials
 
+    def _applied_force(self, trials, applied) -> np.ndarray | None:
+        """−Σ Bᵀ λ_applied (N) of the trials' prescribed multipliers, or None without any."""
+        f = None
+        for tr, app in zip(trials, applied):
+            if app is not None and np.any(app):
+                part = -(tr.matrix.T @ app)
+                f = part if f is None else f + part
+        return f
+
     def _impulse_at_t(self) -> None:
         """Impulse at the current time t for the step self.dt: sets v^{n+1/2}, v^n, λ^n, the
         constraint states after it and the powers at t."""
         dt_prev, dt = self._dt_prev, self.dt
         dt_bar = 0.5 * (dt_prev + dt)
         v_minus = self._v_minus
-        v_star = v_minus + dt_bar * self.a
+        v_star = self._kick(v_minus, dt_bar)
         tic = time.perf_counter()
         lam_e, lam_a, fulls, g_a, v_next, trials = self._impulse(v_star, dt_bar)
         self.constraint_time += time.perf_counter() - tic
@@ -389,6 +310,10 @@ class CentralDifference(Integrator):
         (pe, pc, po), (qe, qc, qo) = self._p_prev, self._powers(v_minus)
         self._w_pending = (half * (pe + qe), half * (pc + qc), half * (po + qo))
 
+    def _kick(self, v_minus: np.ndarray, dt_bar: float) -> np.ndarray:
+        """The free prediction v* = v^{n−½} + Δt̄_n a^n (a new array)."""
+        return v_minus + dt_bar * self.a
+
     def _kinetic(self) -> np.ndarray:
         """The scheme's kinetic energy per block (J): ½ ṽ^{n−½}·M v^{n+½}, with ṽ^{n−½} the
         mid-step velocity the step Δt_n would have before t_n (v^{n−½} for a constant step)."""
@@ -407,6 +332,8 @@ class CentralDifference(Integrator):
             pc, po = np.zeros(nb), np.zeros(nb)
         if self._g_a.shape[0]:
             po = po + unilateral_block_power(self.ops, self._g_a, self._lam_a / self._dt_bar, v)
+        if self._f_applied is not None:  # slip friction
+            po = po + self.ops.block_dots(self._f_applied, v)
         return p_ext, pc, po
 
     def _forces(
@@ -451,7 +378,7 @@ class CentralDifference(Integrator):
         return (
             "_v_next", "_v_minus", "_dt_prev", "_dt_bar", "_f_int", "_f_ext", "_lam_e", "_lam_a",
             "_g_a", "_p_prev", "_w_pending", "_pre_impulse_states", "_critical_now",
-            "_critical_at", "_impulse_failed",
+            "_critical_at", "_impulse_failed", "_f_applied",
         )  # fmt: skip
 
     # ------------------------------------------------------------------ step
@@ -478,6 +405,7 @@ class CentralDifference(Integrator):
         self._v_minus = v_half
         self.step_size = dt
         self.step_count += 1
+        self._phase_advanced()
         # the next step and the impulse at t_{n+1} that depends on it
         try:
             self.dt = self._next_step_size()

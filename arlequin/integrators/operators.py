@@ -10,7 +10,7 @@ of :mod:`arlequin.contract`) or, with ``tangent="initial"``, the model's ``stiff
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -178,11 +178,15 @@ class SystemOperators:
 
     def internal_force(
         self, u: np.ndarray, states: Mapping[str, list[Any]], tangent: bool = False,
-        dt: float | None = None,
+        dt: float | None = None, blocks: Sequence[int] | None = None,
     ) -> tuple[np.ndarray, dict[str, list[Any]], sp.csr_matrix | None]:  # fmt: skip
         """Internal force (N) at ``u`` from the committed ``states``; ``dt`` (s) is the step that
         leads to ``u``, passed to the models whose ``uses_time_step`` is True (rate-dependent
         laws, bulk viscosity; None at the initial time).
+
+        ``blocks`` (indices) restricts the evaluation to those blocks (the force is zero on the
+        others and their states are the committed ones): a subcycling integrator evaluates its
+        slow blocks only at their own steps. Not combined with ``tangent``.
 
         Returns
         -------
@@ -193,15 +197,24 @@ class SystemOperators:
         tangent : sparse (n, n) or None
             Tangent (N/m) when ``tangent`` is True (see the ``tangent`` parameter of the class).
         """
-        # the assembled (linear) part; nothing to multiply when every term is nonlinear
-        f = self.stiffness @ u if self.stiffness.nnz else np.zeros(u.shape)
+        if blocks is not None:
+            if tangent:
+                raise ValueError("internal_force: a tangent is assembled for every block")
+            idx, k_rows, terms = self._rows_of(tuple(blocks))
+            f = np.zeros(u.shape)
+            if k_rows.nnz:
+                f[idx] = k_rows @ u
+        else:
+            # the assembled (linear) part; nothing to multiply when every term is nonlinear
+            f = self.stiffness @ u if self.stiffness.nnz else np.zeros(u.shape)
+            terms = self._nonlinear_terms
         trial = {name: list(s) for name, s in states.items()}
-        if not self._nonlinear_terms:
+        if not terms:
             return f, trial, (self.stiffness if tangent else None)
         if tangent:
             self.check_tangents("a tangent of the coupled system")
         kt_blocks: dict[int, sp.csr_matrix] = {}
-        for bi, ti, term in self._nonlinear_terms:
+        for bi, ti, term in terms:
             b = self.blocks[bi]
             ut = self._term_u(b, term, u)
             state = states[b.name][ti]
@@ -227,6 +240,18 @@ class SystemOperators:
             ]
             kt_full = (self.stiffness + sp.block_diag(blocks, format="csr")).tocsr()
         return f, trial, kt_full
+
+    def _rows_of(self, blocks: tuple[int, ...]):
+        """The dofs of ``blocks``, the rows of the linear stiffness on them and their
+        nonlinear terms (cached by the tuple of block indices)."""
+        cache = self.__dict__.setdefault("_rows_cache", {})
+        if blocks not in cache:
+            idx = np.concatenate(
+                [np.arange(self.offsets[b], self.offsets[b + 1]) for b in sorted(set(blocks))]
+            ) if blocks else np.zeros(0, dtype=np.int64)  # fmt: skip
+            terms = [(bi, ti, t) for bi, ti, t in self._nonlinear_terms if bi in blocks]
+            cache[blocks] = (idx, self.stiffness[idx].tocsr(), terms)
+        return cache[blocks]
 
     def initial_stiffness(self) -> sp.csr_matrix:
         """Block-diagonal weighted stiffness of every block (N/m): the linear stiffness, and the

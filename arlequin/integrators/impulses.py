@@ -1,0 +1,120 @@
+"""The impulse solve of the explicit scheme: (B M⁻¹ Bᵀ) Λ = r for the equality rows plus the
+active unilateral rows (contact), with the equality block factorised once and the active rows
+added by a Schur complement (dense, cached by the rows' content) or one sparse factorisation
+when there are many of them."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+
+from ..contract import ConstraintError
+from .linalg import factor_checked
+from .rows import rows_key
+
+__all__ = ["ImpulseSolver"]
+
+
+class ImpulseSolver:
+    """Solves (B M⁻¹ Bᵀ) Λ = r for the equality rows E plus the active unilateral rows A.
+
+    The equality block S_EE is factorised once; active rows enter by a Schur complement
+    (dense, cached for the last active rows, keyed by their content), or by a sparse
+    factorisation of the whole matrix when there are many of them.
+    """
+
+    _DENSE_SCHUR = 300
+
+    def __init__(self, rows, inv_mass: np.ndarray) -> None:
+        self.rows = rows
+        self.inv_mass = inv_mass
+        self.m_e = rows.m
+        if self.m_e:
+            bj = rows.matrix_cols
+            s = (bj @ sp.diags(inv_mass[rows.cols]) @ bj.T).tocsc()
+            self.s_ee = s
+            self.lu = factor_checked(
+                s, "the impulse matrix B M⁻¹ Bᵀ of the equality rows", rows.row_name, spd=True
+            )
+        else:
+            self.s_ee = None
+            self.lu = None
+        self._cache: dict[Any, Any] = {}
+        self._last_key: tuple[Any, bytes] | None = None
+        self._eq_mask = np.zeros(inv_mass.size, dtype=bool)
+        if self.m_e:
+            self._eq_mask[rows.cols] = True
+
+    def solve_equality(self, r: np.ndarray) -> np.ndarray:
+        """Λ_E (N·s per row unit) of the equality rows alone for the right-hand side r (m_E,)."""
+        return self.lu.solve(r) if self.m_e else np.zeros(0)
+
+    def _cached(self, key: bytes, build):
+        fac = self._cache.get(key)
+        if fac is None:
+            fac = build()
+            self._cache = {key: fac}
+        return fac
+
+    def _key(self, g_a: sp.csr_matrix) -> bytes:
+        last = self._last_key
+        if last is not None and last[0] is g_a:  # the same stacked rows as last time
+            return last[1]
+        key = rows_key(g_a)
+        self._last_key = (g_a, key)
+        return key
+
+    def solve(self, r_e: np.ndarray, g_a: sp.csr_matrix, r_a: np.ndarray):
+        """Return (Λ_E, Λ_A) for right-hand sides r_e (m_E,), r_a (m_A,) and active rows g_a."""
+        m_a = g_a.shape[0]
+        if m_a == 0:
+            return self.solve_equality(r_e), np.zeros(0)
+        key = self._key(g_a)
+        minv = self.inv_mass
+        if self.m_e and not self._eq_mask[g_a.indices].any():
+            # no dof shared with the equality rows (a wall and a symmetry axis): two blocks
+            def build_aa_only():
+                s_aa = (g_a @ sp.diags(minv) @ g_a.T).tocsr()
+                return factor_checked(s_aa, "the impulse matrix of the active rows", spd=True)
+
+            return self.solve_equality(r_e), self._cached(key, build_aa_only).solve(r_a)
+        if self.m_e == 0:
+
+            def build_aa():
+                s_aa = (g_a @ sp.diags(minv) @ g_a.T).tocsr()
+                return factor_checked(s_aa, "the impulse matrix of the active rows", spd=True)
+
+            return np.zeros(0), self._cached(key, build_aa).solve(r_a)
+        s_ae = (g_a @ sp.diags(minv) @ self.rows.matrix.T).tocsr()
+        if m_a <= self._DENSE_SCHUR:
+
+            def build_schur():
+                s_aa = (g_a @ sp.diags(minv) @ g_a.T).tocsr()
+                x = self.lu.solve(s_ae.T.toarray()) if s_ae.nnz else np.zeros((self.m_e, m_a))
+                schur = s_aa.toarray() - s_ae @ x
+                try:
+                    cho = sla.cho_factor(schur)
+                except np.linalg.LinAlgError as exc:
+                    raise ConstraintError(
+                        "active unilateral rows are dependent on each other or on the equality "
+                        f"rows ({m_a} active rows)"
+                    ) from exc
+                return x, cho
+
+            x, cho = self._cached(key, build_schur)
+            y = self.lu.solve(r_e)
+            lam_a = sla.cho_solve(cho, r_a - s_ae @ y)
+            return y - x @ lam_a, lam_a
+
+        def build_full():
+            s_aa = (g_a @ sp.diags(minv) @ g_a.T).tocsr()
+            full = sp.bmat([[self.s_ee, s_ae.T], [s_ae, s_aa]], format="csc")
+            return factor_checked(full, "the impulse matrix with the active rows", spd=True)
+
+        sol = self._cached(key, build_full).solve(np.concatenate([r_e, r_a]))
+        return sol[: self.m_e], sol[self.m_e :]
+
+
