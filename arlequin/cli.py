@@ -79,7 +79,17 @@ def _add_patch_test(sub) -> None:
 def _cmd_two_bars(args: argparse.Namespace) -> int:
     from .demos.two_bars import plot_two_bars, run_two_bars
 
-    result = run_two_bars(
+    with progress_bar(100.0, "%", args.quiet, scale=100.0, label="two bars") as update:
+        result = _two_bars(args, run_two_bars, update)
+    print(result.summary())
+    _write_json(args.json, result.to_json())
+    if args.plot:
+        plot_two_bars(result, args.plot)
+    return 0
+
+
+def _two_bars(args: argparse.Namespace, run_two_bars, update):
+    return run_two_bars(
         method=args.method,
         newmark=args.newmark,
         lengths=tuple(args.lengths),
@@ -92,12 +102,8 @@ def _cmd_two_bars(args: argparse.Namespace) -> int:
         theta=args.theta,
         t_end=args.t_end,
         out=args.out,
+        progress=update,
     )
-    print(result.summary())
-    _write_json(args.json, result.to_json())
-    if args.plot:
-        plot_two_bars(result, args.plot)
-    return 0
 
 
 def _add_two_bars(sub) -> None:
@@ -137,6 +143,7 @@ def _add_two_bars(sub) -> None:
     )
     p.add_argument("--json", metavar="PATH", default=None, help="write the histories as JSON")
     p.add_argument("--plot", metavar="PNG", default=None, help="plot against the exact solution")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
     _add_out(p)
     p.set_defaults(func=_cmd_two_bars)
 

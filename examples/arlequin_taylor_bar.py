@@ -28,6 +28,9 @@ from arlequin.models import (
     make_hardening,
 )
 
+#: The pictures of this example in the documentation's gallery (paths under docs/).
+GALLERY_IMAGES = ["gallery/arlequin_taylor_bar.png", "gallery/arlequin_taylor_bar_history.png"]
+
 
 def run(fine_radial: int = 10, t_end: float = 80e-6) -> dict:
     """Final length and footprint radius (m) of the bar at ``t_end`` (s), ``fine_radial`` patch

@@ -15,6 +15,9 @@ from pathlib import Path
 from arlequin.demos.block_impact import run_block_impact
 from arlequin.demos.two_bars import plot_two_bars, run_two_bars, run_wall
 
+#: The pictures of this example in the documentation's gallery (paths under docs/).
+GALLERY_IMAGES = ["two_bars.png", "two_bars_hht.png"]
+
 DOCS = Path(__file__).resolve().parent.parent / "docs"
 
 

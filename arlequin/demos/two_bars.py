@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import logging
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -115,9 +116,27 @@ class _Scheme:
     theta: float
 
 
+def _progress_listener(progress, t_end: float, span: tuple[float, float]):
+    """An on_step listener reporting ``span[0] + (span[1] − span[0]) t/t_end`` at each new
+    percent (None without ``progress``)."""
+    if progress is None:
+        return None
+    last = [-1]
+
+    def report(integ) -> None:
+        frac = span[0] + (span[1] - span[0]) * min(integ.t / t_end, 1.0)
+        pct = int(100 * frac)
+        if pct != last[0]:
+            last[0] = pct
+            progress(frac)
+
+    return report
+
+
 def _run_1d(
-    setup: _Impact, scheme: _Scheme, folder: ResultsFolder | None = None, prefix: str = ""
-) -> TwoBarsResult:
+    setup: _Impact, scheme: _Scheme, folder: ResultsFolder | None = None, prefix: str = "",
+    progress: Callable[[float], None] | None = None, span: tuple[float, float] = (0.0, 1.0),
+) -> TwoBarsResult:  # fmt: skip
     bodies, names = setup.bodies, setup.names
     method, newmark, integrator, theta = (
         scheme.method, scheme.newmark, scheme.integrator, scheme.theta
@@ -136,6 +155,7 @@ def _run_1d(
     if folder is not None:
         frames = np.linspace(0.0, t_end, 61)
         writers.append(DynamicRunWriter(folder, system, frame_times=frames, prefix=prefix))
+    listener = _progress_listener(progress, t_end, span)
     res = solve(
         system,
         integ,
@@ -145,6 +165,7 @@ def _run_1d(
         constraints=[con],
         save_fields=True,
         on_record=writers,
+        on_step=[listener] if listener is not None else [],
         **opts,
     )
     if res.n_status_failures:
@@ -204,6 +225,7 @@ def run_two_bars(
     t_end: float | None = None,
     integrator: str = "theta",
     out: str | Path | None = None,
+    progress: Callable[[float], None] | None = None,
 ) -> TwoBarsResult:
     """Impact of two bars touching at t = 0 (see the module docstring).
 
@@ -234,6 +256,9 @@ def run_two_bars(
         Results folder (:class:`arlequin.io.ResultsFolder`): results.json, history.csv and
         one field series per bar (the Newmark baseline of ``method="both"`` in files prefixed
         ``newmark-trapezoidal_`` or ``newmark-hht_``), two_bars.png.
+    progress : callable, optional
+        ``progress(fraction)`` with the fraction of the simulated time done (both runs of
+        ``method="both"`` together), at each new percent (the CLI's progress bar).
 
     Returns
     -------
@@ -279,7 +304,7 @@ def run_two_bars(
     def interface_dof(dofmap):
         return int(dofmap["bar2"].node_dofs([np.argmin(bar2.mesh.p[0])])[0, 0])
 
-    def one(meth: str, prefix: str = "") -> TwoBarsResult:
+    def one(meth: str, prefix: str = "", span: tuple[float, float] = (0.0, 1.0)) -> TwoBarsResult:
         setup = _Impact(
             [bar1, bar2],
             ["bar1", "bar2"],
@@ -292,14 +317,15 @@ def run_two_bars(
             dt,
             t_end,
         )
-        return _run_1d(setup, _Scheme(meth, newmark, integrator, theta), folder, prefix)
+        return _run_1d(setup, _Scheme(meth, newmark, integrator, theta), folder, prefix,
+                       progress, span)  # fmt: skip
 
     folder = _folder(out, "arlequin two-bars", dict(config, method=method, newmark=newmark,
                                                       integrator=integrator))  # fmt: skip
     if method == "both":
-        res = one("levelset")
+        res = one("levelset", span=(0.0, 0.5))
         # the baseline's files are prefixed (newmark-trapezoidal_history.csv...)
-        res.newmark = one("newmark", f"newmark-{newmark}_")
+        res.newmark = one("newmark", f"newmark-{newmark}_", span=(0.5, 1.0))
     else:
         res = one(method)
     _finish(folder, res)
