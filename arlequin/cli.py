@@ -19,6 +19,7 @@ from .cli_common import add_out as _add_out
 from .cli_common import check_writable as _check_writable
 from .cli_common import write_json as _write_json
 from .cli_info import add_info
+from .cli_sliding import add_sliding_block
 from .cli_taylor import add_taylor_bar
 from .contract import SimulationError
 
@@ -211,6 +212,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_two_bars(sub)
     _add_wave(sub)
     add_taylor_bar(sub)
+    add_sliding_block(sub)
     add_info(sub)
     return parser
 

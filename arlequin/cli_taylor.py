@@ -53,6 +53,7 @@ def _cmd_taylor_bar(args: argparse.Namespace) -> int:
             model=args.model,
             elements_radial=args.elements_radial,
             mesh_size=args.mesh_size,
+            friction=args.friction,
             t_end=args.t_end,
             velocity=args.velocity,
             young=args.young,
@@ -150,6 +151,8 @@ def add_taylor_bar(sub) -> None:
                    help="arlequin: mediator space (default fine)")  # fmt: skip
     p.add_argument("--coupling", choices=["L2", "H1"], default=None,
                    help="arlequin: coupling operator (default H1)")  # fmt: skip
+    p.add_argument("--friction", type=float, default=0.0, metavar="MU",
+                   help="Coulomb friction between the bar and the wall (0: frictionless)")
     p.add_argument(
         "--coarse-step-ratio",
         type=int,

@@ -325,6 +325,11 @@ class ConstraintTrial(Protocol):
         Whether the last :meth:`UnilateralConstraint.update_status` changed a status.
     iterations : int
         Status updates made in this step.
+
+    A trial may also carry ``applied`` (ndarray (m,) or None): prescribed multipliers of
+    inactive rows, a force −Bᵀλ_applied during the step (slip friction); the explicit
+    integrator adds it to the free velocity, reports it with the multipliers and passes its
+    impulse to ``commit``. Constraints that use it declare ``explicit_only = True``.
     """
 
     active: np.ndarray

@@ -9,7 +9,8 @@ Modules: ``elastic`` (small-strain linear elasticity), ``hardening`` (isotropic 
 laws), ``j2`` (the J2 material point), ``kinematics`` (finite-strain Q1 kinematics, F-bar),
 ``j2_kernel`` (the compiled planar kernel), ``elastoplastic`` (finite-strain J2 model),
 ``obstacles`` (rigid level-set obstacles), ``contact_geometry`` (contact surfaces and pairs),
-``contact`` (the level-set Signorini–Moreau contact model and the Signorini baseline).
+``contact`` (the level-set Signorini–Moreau contact model and the Signorini baseline),
+``friction`` (Coulomb friction in the level-set model).
 """
 
 from .contact import (
@@ -36,6 +37,7 @@ from .elastic import (
     scalar_element_for,
 )
 from .elastoplastic import BACKENDS, BulkViscosity, FiniteStrainJ2
+from .friction import CoulombContact, FrictionState
 from .hardening import (
     HARDENING_LAWS,
     CallableHardening,
@@ -70,8 +72,10 @@ __all__ = [
     "ContactRecord",
     "ContactState",
     "ContactSurface",
+    "CoulombContact",
     "DeformableContactPair",
     "FiniteStrainJ2",
+    "FrictionState",
     "Hardening",
     "InvertedElementError",
     "IsotropicElastic",

@@ -120,6 +120,7 @@ class ContactSurface:
             meas = _facet_measure(_facet_points(mesh.p, fn))
         nv = fn.shape[1]
         contrib = np.repeat(meas / nv, nv)
+        self.axisymmetric = bool(axisymmetric)
         if axisymmetric:
             if self.dim != 2:
                 raise ValueError(

@@ -267,3 +267,20 @@ def test_multi_time_step_run_matches_the_one_step_run(short_run):
     assert mts.energy_balance_error < 1e-2
     h = np.asarray(mts.history["coupling_work"])
     assert np.abs(h).max() < 1e-6 * one.initial_kinetic_energy
+
+
+def test_friction_shrinks_the_footprint_and_closes_the_balance(short_run):
+    # 4 cells, 12 µs; the full runs (docs/contact.md): radius 7.307 → 6.808 → 5.898 mm at
+    # μ = 0, 0.1, 0.3 (10 cells, 80 µs), balance 1.4e-3, 1.8–2.0 fixed-point iterations per step
+    one, _ = short_run
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", GluingBandPlasticityWarning)
+        fr = run_taylor_bar(elements_radial=4, t_end=12e-6, friction=0.3)
+    assert fr.mushroom_radius < one.mushroom_radius
+    assert fr.energy_balance_error < 1e-2
+    work = np.asarray(fr.history["friction_work"])
+    assert work[-1] < 0.0 and np.all(np.diff(work) <= 1e-9 * one.initial_kinetic_energy)
+    assert fr.fixed_point_iterations["mean"] <= 10
+    assert "friction_work" not in one.history  # μ = 0: the frictionless model, unchanged
+    data = fr.to_json()
+    assert data["config"]["friction"] == 0.3 and "friction_work" in data["history"]

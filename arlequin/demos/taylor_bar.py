@@ -33,6 +33,7 @@ and taylor_bar_history.png.
 from __future__ import annotations
 
 import logging
+import math
 import time
 import warnings
 from collections.abc import Callable
@@ -43,7 +44,7 @@ import numpy as np
 
 from ..integrators import CriticalFraction, solve
 from ..io import ResultsFolder
-from ..models import HARDENING_LAWS, BulkViscosity, J2Material, make_hardening
+from ..models import BulkViscosity, J2Material
 from ..weights import PartitionWeights
 from .taylor_checkpoint import CheckpointWriter, load_checkpoint, read_frames
 from .taylor_meshes import (
@@ -54,7 +55,7 @@ from .taylor_meshes import (
     positive,
     taylor_bar_mesh,
 )
-from .taylor_models import ArlequinBar, MonoBar
+from .taylor_models import LAW_DEFAULTS, ArlequinBar, MonoBar, hardening_parameters
 from .taylor_record import HISTORY_UNITS, MultiplierHistory, TaylorRecorder, write_results
 from .taylor_result import (
     ARLEQUIN_JSON_KEYS,
@@ -81,14 +82,6 @@ __all__ = [
 
 logger = logging.getLogger(__name__)
 
-#: Default parameters of each hardening law (Pa, dimensionless, 1/s); σ_y0 and H come from
-#: ``yield_stress`` and ``hardening`` for every law.
-LAW_DEFAULTS: dict[str, dict[str, float]] = {
-    "linear": {},
-    "voce": {"voce_saturation": 0.1e9, "voce_rate": 10.0},
-    "johnson-cook": {"jc_b": 0.292e9, "jc_n": 0.31, "jc_c": 0.0, "jc_reference_rate": 1.0},
-}
-
 _INPUT_UNITS = {
     "length": "m", "radius": "m", "velocity": "m/s", "young": "Pa", "poisson": "1",
     "density": "kg/m^3", "yield_stress": "Pa", "hardening": "Pa", "t_end": "s",
@@ -98,7 +91,7 @@ _INPUT_UNITS = {
     "bulk_viscosity_linear": "1", "bulk_viscosity_quadratic": "1", "coarse_radial": "1",
     "coarse_axial": "1", "ratio": "1", "patch_rows": "1", "band_rows": "1", "coarse_size": "m",
     "fine_size": "m", "patch_length": "m", "gluing_width": "m", "epsilon": "1",
-    "band_warning": "1", "coarse_step_ratio": "1",
+    "band_warning": "1", "coarse_step_ratio": "1", "friction": "1",
 }  # fmt: skip
 
 _RESULT_UNITS = {
@@ -112,28 +105,6 @@ _RESULT_UNITS = {
     "band_max_plastic_strain": "1", "multiplier_chatter": "1",
     "multiplier_chatter_per_row": "1",
 }  # fmt: skip
-
-
-def hardening_parameters(law: str, yield_stress: float, hardening: float, **params: float):
-    """The :class:`~arlequin.models.Hardening` of a law name and the CLI's parameters.
-
-    ``linear``: σ_y0 + H ε̄p; ``voce``: σ_y0 + Q(1 − e^{−b ε̄p}) + H ε̄p (``voce_saturation`` Q,
-    ``voce_rate`` b); ``johnson-cook``: (σ_y0 + B ε̄p^n)(1 + C ln(ε̄̇p/ε̄̇0)) (``jc_b``, ``jc_n``,
-    ``jc_c``, ``jc_reference_rate``; H unused).
-    """
-    if law not in HARDENING_LAWS:
-        raise ValueError(f"hardening law must be one of {HARDENING_LAWS}, got {law!r}")
-    p = {**LAW_DEFAULTS[law], **{k: v for k, v in params.items() if v is not None}}
-    unknown = set(p) - set(LAW_DEFAULTS[law])
-    if unknown:
-        raise ValueError(f"parameters {sorted(unknown)} do not belong to the {law} law")
-    if law == "linear":
-        return make_hardening("linear", yield_stress=yield_stress, modulus=hardening)
-    if law == "voce":
-        return make_hardening("voce", yield_stress=yield_stress, saturation=p["voce_saturation"],
-                              rate=p["voce_rate"], modulus=hardening)  # fmt: skip
-    return make_hardening("johnson-cook", a=yield_stress, b=p["jc_b"], n=p["jc_n"], c=p["jc_c"],
-                          reference_rate=p["jc_reference_rate"])  # fmt: skip
 
 
 def run_taylor_bar(
@@ -161,6 +132,7 @@ def run_taylor_bar(
     coupling: str | None = None,
     coarse_step_ratio: int | None = None,
     band_warning: float | None = None,
+    friction: float = 0.0,
     fbar: bool = True,
     backend: str = "auto",
     safety: float = 0.8,
@@ -224,6 +196,9 @@ def run_taylor_bar(
         the coarse model within its own stable step; without its resonance bound, the run
         stopped with a :class:`~arlequin.contract.SimulationError` if the energy balance
         error passes 1%).
+    friction : float
+        Coulomb coefficient μ between the bar and the wall (default 0: the frictionless model,
+        no tangential rows); the history then gains ``friction_work`` (J, ≤ 0).
     band_warning : float, optional
         ``arlequin`` only: warn (:class:`GluingBandPlasticityWarning`) when ε̄p in the gluing
         band exceeds this (default 0.02): the coarse model there is elastic.
@@ -315,6 +290,9 @@ def run_taylor_bar(
                                  ("coupling", coupling, ("L2", "H1"))):  # fmt: skip
         if value not in choices:
             raise ValueError(f"{name} must be one of {choices}, got {name}={value!r}")
+    if isinstance(friction, bool) or not (isinstance(friction, (int, float))
+                                          and math.isfinite(friction) and friction >= 0.0):
+        raise ValueError(f"friction must be a non-negative number (Coulomb μ), got {friction!r}")
     if not (isinstance(band_warning, (int, float)) and band_warning >= 0.0):
         raise ValueError(f"band_warning must be a non-negative number, got {band_warning!r}")
     law = hardening_parameters(hardening_law, yield_stress, hardening, **law_parameters)
@@ -336,20 +314,21 @@ def run_taylor_bar(
     if model == "graded":
         bar: MonoBar | ArlequinBar = MonoBar(
             length, radius, n_r, material, fbar, backend, visc,
-            mesh=graded_bar_mesh(length, radius, sizes),
+            mesh=graded_bar_mesh(length, radius, sizes), friction=friction,
         )  # fmt: skip
         n_z = 2 * sizes.patch_rows
     elif arlequin:
         bar = ArlequinBar(
             length, radius, sizes, material, weights=weights, mediator=mediator,
             coupling=coupling, fbar=fbar, backend=backend, bulk_viscosity=visc,
+            friction=friction,
         )  # fmt: skip
         n_z = sizes.patch_rows * sizes.ratio
         config.update(weights=str(weights), mediator=mediator, coupling=coupling,
                       coarse_step_ratio=int(coarse_step_ratio), band_warning=band_warning,
                       epsilon=bar.problem.patches[0].epsilon)  # fmt: skip
     else:
-        bar = MonoBar(length, radius, n_r, material, fbar, backend, visc)
+        bar = MonoBar(length, radius, n_r, material, fbar, backend, visc, friction=friction)
         n_z = bar.mesh.t.shape[1] // n_r
     fine_model = bar.model
     config.update({
@@ -359,7 +338,7 @@ def run_taylor_bar(
         "hardening_law": hardening_law, "length": length, "radius": radius,
         "bulk_viscosity": bool(visc), "fbar": bool(fbar), "backend": backend, "safety": safety,
         "estimate_every": int(estimate_every), "sample_interval": sample_interval,
-        "frame_interval": frame_interval,
+        "frame_interval": frame_interval, "friction": float(friction),
         **{k: v for k, v in law_parameters.items() if v is not None},
     })  # fmt: skip
     if visc:
@@ -399,7 +378,7 @@ def run_taylor_bar(
         mts = {"slow_blocks": (bar.coarse_block,), "step_ratio": int(coarse_step_ratio),
                "safety": safety, "resonance_bound": False,
                "energy_tolerance": 0.01} if coarse_step_ratio > 1 else {}  # fmt: skip
-        on_step = [lam_history] if lam_history is not None else []
+        on_step = [rec.count_step] + ([lam_history] if lam_history is not None else [])
         if mts:
             on_step.append(lambda integ: mts_seen.__setitem__("integ", integ))
         res = solve(bar.system, "explicit-mts" if mts else "explicit", t_end=t_end, v0=v0,
@@ -438,6 +417,7 @@ def run_taylor_bar(
         max_plastic_strain_at=[float(xq[0]), float(xq[1])],
         initial_kinetic_energy=ke0,
         impact_loss=hist["contact_work"][0],
+        fixed_point_iterations=rec.iteration_summary(),
         min_dt=float(steps[steps > 0].min()) if np.any(steps > 0) else float(res.dt),
         qp_updates_per_second=n_qp * res.n_steps / loop_time,
         setup_time_s=wall_time - loop_time,

@@ -35,35 +35,72 @@ import scipy.sparse as sp
 import skfem
 
 from ..models import (
+    HARDENING_LAWS,
     ContactSurface,
+    CoulombContact,
     FiniteStrainJ2,
     J2Material,
     LevelSetContact,
     LinearElastic,
     PlaneObstacle,
     RigidContactPair,
+    make_hardening,
 )
 from ..problem import ArlequinProblem, Patch
 from ..system import Block, BlockTerm, CoupledSystem, LinearConstraint
 from .taylor_meshes import ArlequinBarSizes, taylor_bar_mesh
 
-__all__ = ["ArlequinBar", "MonoBar"]
+__all__ = ["LAW_DEFAULTS", "ArlequinBar", "MonoBar", "hardening_parameters"]
 
 #: Part of the lateral surface, from the impact face, that the wall may meet (it folds onto the
 #: wall as the mushroom forms), as a fraction of the bar length.
 LATERAL_CONTACT = 0.3
 
 
-def _wall(mesh, offset, dofmap, material, tol, lateral, radius) -> LevelSetContact:
-    """The level-set wall z = 0 on the impact face and the lower lateral surface of a mesh."""
+#: Default parameters of each hardening law (Pa, dimensionless, 1/s); σ_y0 and H come from
+#: ``yield_stress`` and ``hardening`` for every law.
+LAW_DEFAULTS: dict[str, dict[str, float]] = {
+    "linear": {},
+    "voce": {"voce_saturation": 0.1e9, "voce_rate": 10.0},
+    "johnson-cook": {"jc_b": 0.292e9, "jc_n": 0.31, "jc_c": 0.0, "jc_reference_rate": 1.0},
+}
+
+def hardening_parameters(law: str, yield_stress: float, hardening: float, **params: float):
+    """The :class:`~arlequin.models.Hardening` of a law name and the CLI's parameters.
+
+    ``linear``: σ_y0 + H ε̄p; ``voce``: σ_y0 + Q(1 − e^{−b ε̄p}) + H ε̄p (``voce_saturation`` Q,
+    ``voce_rate`` b); ``johnson-cook``: (σ_y0 + B ε̄p^n)(1 + C ln(ε̄̇p/ε̄̇0)) (``jc_b``, ``jc_n``,
+    ``jc_c``, ``jc_reference_rate``; H unused).
+    """
+    if law not in HARDENING_LAWS:
+        raise ValueError(f"hardening law must be one of {HARDENING_LAWS}, got {law!r}")
+    p = {**LAW_DEFAULTS[law], **{k: v for k, v in params.items() if v is not None}}
+    unknown = set(p) - set(LAW_DEFAULTS[law])
+    if unknown:
+        raise ValueError(f"parameters {sorted(unknown)} do not belong to the {law} law")
+    if law == "linear":
+        return make_hardening("linear", yield_stress=yield_stress, modulus=hardening)
+    if law == "voce":
+        return make_hardening("voce", yield_stress=yield_stress, saturation=p["voce_saturation"],
+                              rate=p["voce_rate"], modulus=hardening)  # fmt: skip
+    return make_hardening("johnson-cook", a=yield_stress, b=p["jc_b"], n=p["jc_n"], c=p["jc_c"],
+                          reference_rate=p["jc_reference_rate"])  # fmt: skip
+
+
+def _wall(mesh, offset, dofmap, material, tol, lateral, radius,
+          friction: float = 0.0) -> LevelSetContact:  # fmt: skip
+    """The level-set wall z = 0 on the impact face and the lower lateral surface of a mesh
+    (Coulomb friction μ = ``friction`` if positive; μ = 0: the frictionless model)."""
 
     def on_wall_side(x):
         return (x[1] < tol) | ((x[0] > radius - tol) & (x[1] < lateral))
 
     surface = ContactSurface(mesh, where=on_wall_side, offset=offset, axisymmetric=True)
     wall = PlaneObstacle(np.zeros(2), np.array([0.0, 1.0]))
-    return LevelSetContact(RigidContactPair(surface, wall, dofmap), material=material,
-                           name="wall")  # fmt: skip
+    pair = RigidContactPair(surface, wall, dofmap)
+    if friction > 0.0:
+        return CoulombContact(pair, friction, material=material, name="wall")
+    return LevelSetContact(pair, material=material, name="wall")
 
 
 class MonoBar:
@@ -85,7 +122,8 @@ class MonoBar:
     fine_block = "bar"
 
     def __init__(self, length, radius, elements_radial, material: J2Material, fbar=True,
-                 backend="auto", bulk_viscosity=None, mesh=None) -> None:  # fmt: skip
+                 backend="auto", bulk_viscosity=None, mesh=None,
+                 friction: float = 0.0) -> None:  # fmt: skip
         if mesh is None:
             mesh = taylor_bar_mesh(length, radius, elements_radial)
         self.mesh = mesh
@@ -103,7 +141,8 @@ class MonoBar:
             [LinearConstraint(rows, None, name="axis", kind="dirichlet")],
         )
         self.contact = _wall(mesh, self.system.dofmap["bar"], self.system.dofmap,
-                             material.elastic, tol, LATERAL_CONTACT * length, radius)  # fmt: skip
+                             material.elastic, tol, LATERAL_CONTACT * length, radius,
+                             friction)  # fmt: skip
         self._axis_top = int(np.nonzero((p[0] < tol) & (p[1] > length - tol))[0][0])
         self._face = np.nonzero(p[1] < tol)[0]
         self._r, self._z = dofs[0], dofs[1]
@@ -189,7 +228,7 @@ class ArlequinBar:
 
     def __init__(self, length, radius, sizes: ArlequinBarSizes, material: J2Material,
                  weights="ramp", mediator="fine", coupling="H1", epsilon=1e-3, fbar=True,
-                 backend="auto", bulk_viscosity=None) -> None:  # fmt: skip
+                 backend="auto", bulk_viscosity=None, friction: float = 0.0) -> None:  # fmt: skip
         s = sizes
         self.sizes = s
         n_f, rows_f = s.coarse_radial * s.ratio, s.patch_rows * s.ratio
@@ -216,7 +255,8 @@ class ArlequinBar:
         dm = self.system.dofmap
         # the wall's lateral reach stays below the gluing band
         lateral = min(LATERAL_CONTACT * length, s.patch_length - s.gluing_width)
-        self.contact = _wall(fmesh, dm["patch"], dm, material.elastic, tol, lateral, radius)
+        self.contact = _wall(fmesh, dm["patch"], dm, material.elastic, tol, lateral, radius,
+                             friction)  # fmt: skip
         self._c = dm["coarse"].slice
         self._f = dm["patch"].slice
         self._cz = dm["coarse"].component_dofs(1)

@@ -58,10 +58,16 @@ class TaylorRecorder:
     def __init__(self, bar, con_name, weights, ke0, folder, frame_times, progress) -> None:
         self.bar, self.con_name, self.weights = bar, con_name, weights
         self.ke0 = ke0
-        self.history: dict[str, list[float]] = {k: [] for k in HISTORY_UNITS}
+        # with friction the history gains the friction work (the frictionless one is unchanged)
+        self.friction = bool(getattr(bar.contact, "friction", 0.0))
+        self.units = dict(HISTORY_UNITS)
+        if self.friction:
+            self.units["friction_work"] = "J"
+        self.history: dict[str, list[float]] = {k: [] for k in self.units}
         self.balance: list[float] = []
-        self.csv = folder.history([*HISTORY_UNITS, "balance_error"],
-                                  {**HISTORY_UNITS, "balance_error": "1"}) if folder else None
+        self.iterations: dict[int, int] = {}  # contact fixed-point iterations -> steps
+        self.csv = folder.history([*self.units, "balance_error"],
+                                  {**self.units, "balance_error": "1"}) if folder else None
         self.series = ({name: folder.series(name, mesh)
                         for name, mesh in bar.series_meshes().items()} if folder else {})
         self.frame_times = np.asarray(frame_times) if folder else np.zeros(0)
@@ -85,6 +91,8 @@ class TaylorRecorder:
         impulse = float(-(cstate.impulse * self.weights).sum())
         if self._last is None:
             lam = integ.multipliers.get(self.con_name)
+            # the normal multipliers come first (a frictional wall adds its tangential ones)
+            lam = None if lam is None else lam[: self.weights.size]
             force = 0.0 if lam is None or not lam.size else float(-(lam * self.weights).sum())
         else:
             force = (impulse - self._last[1]) / (integ.t - self._last[0])
@@ -99,13 +107,17 @@ class TaylorRecorder:
             "contact_force": force,
             "dt": float(integ.step_size or 0.0),
         }
-        # KE + W_el + D_p + D_visc + W_c = KE_0 + W_coupling (the net work of the coupling
-        # forces: zero for a mediator enforced exactly, kept to show it)
+        # KE + W_el + D_p + D_visc + W_c (+ D_f) = KE_0 + W_coupling (the net work of the
+        # coupling forces: zero for a mediator enforced exactly, kept to show it)
+        wf = 0.0
+        if self.friction:
+            wf = -float(cstate.friction_work)
+            row["friction_work"] = -wf
         err = abs(kinetic + parts["elastic"] + parts["plastic_dissipation"]
-                  + parts["viscous_dissipation"] + wc - parts["coupling_work"]
+                  + parts["viscous_dissipation"] + wc + wf - parts["coupling_work"]
                   - self.ke0) / self.ke0  # fmt: skip
         self.balance.append(err)
-        for k in HISTORY_UNITS:
+        for k in self.units:
             self.history[k].append(row[k])
         if self.csv is not None:
             self.csv.append({**row, "balance_error": err})
@@ -119,11 +131,25 @@ class TaylorRecorder:
             self.progress(float(integ.t))
 
 
+    def count_step(self, integ) -> None:
+        """An ``on_step`` listener: the distribution of the contact fixed-point iterations."""
+        k = int(integ.status_iterations)
+        self.iterations[k] = self.iterations.get(k, 0) + 1
+
+    def iteration_summary(self) -> dict[str, Any]:
+        """``{"mean", "max", "counts"}`` of the fixed-point iterations per step."""
+        steps = sum(self.iterations.values())
+        if not steps:
+            return {"mean": 0.0, "max": 0, "counts": {}}
+        mean = sum(k * n for k, n in self.iterations.items()) / steps
+        return {"mean": mean, "max": max(self.iterations),
+                "counts": {k: self.iterations[k] for k in sorted(self.iterations)}}
+
     def state(self) -> dict[str, Any]:
         """What the run has recorded so far (a checkpoint; see :meth:`restore`)."""
         return {"history": {k: list(v) for k, v in self.history.items()},
                 "balance": list(self.balance), "next_frame": self._next_frame,
-                "last": self._last}  # fmt: skip
+                "last": self._last, "iterations": dict(self.iterations)}  # fmt: skip
 
     def restore(self, state: dict[str, Any], frames: dict[str, list]) -> None:
         """Continue from a :meth:`state`: the history rows and the field frames written until
@@ -133,6 +159,7 @@ class TaylorRecorder:
         self.balance = list(state["balance"])
         self._next_frame = int(state["next_frame"])
         self._last = state["last"]
+        self.iterations = dict(state.get("iterations", {}))
         if self.csv is not None:
             for i, err in enumerate(self.balance):
                 self.csv.append({**{k: v[i] for k, v in self.history.items()},

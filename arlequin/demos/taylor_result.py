@@ -98,6 +98,9 @@ class TaylorBarResult(JsonResult):
         The inputs.
     reference : dict
         The published values at 80 µs (m), :data:`TAYLOR_REFERENCE`.
+    fixed_point_iterations : dict or None
+        The wall contact's fixed-point iterations per step: ``mean``, ``max`` and ``counts``
+        (iterations -> steps).
     arlequin : dict or None
         ``arlequin`` (and, for its sizes, ``graded``), flattened into the JSON:
         coarse_elements, fine_elements, coarse_size and fine_size (m, edges across the radius),
@@ -138,6 +141,7 @@ class TaylorBarResult(JsonResult):
     state: Any = field(default=None, repr=False)
     setup: Any = field(default=None, repr=False)
     arlequin: dict[str, Any] | None = None
+    fixed_point_iterations: dict[str, Any] | None = None
     multiplier_history: Any = field(default=None, repr=False)
 
     json_exclude = ("model", "u", "state", "setup", "arlequin", "multiplier_history")

@@ -81,7 +81,7 @@ class SubcycledCentralDifference(CentralDifference):
         docstring). False leaves the energy check alone to stop a resonating run (for fast
         modes that the slow force does not reach, e.g. localised far from the gluing zone).
     energy_tolerance : float
-        Largest relative energy balance error (|balance| / the largest energy or external work
+        Largest relative energy balance error (abs(balance) / the largest energy or external work
         so far) accepted; checked every ``check_every`` macro steps. Beyond it the run stops
         with a :class:`~arlequin.contract.SimulationError`: a macro step resonating with the
         fast partition's frequencies makes the impulse scheme unstable (the module docstring),
@@ -283,7 +283,7 @@ class SubcycledCentralDifference(CentralDifference):
         return 0.5 * self.ops.block_dots(back, self.ops.mass * self._v_next)
 
     def energy_balance_error(self) -> float:
-        """|E − E(0) − W_ext − W_c − W_r| / max(E, |W_ext|) so far (dimensionless)."""
+        """``|E − E(0) − W_ext − W_c − W_r| / max(E, |W_ext|)`` so far (dimensionless)."""
         e = self.energies()
         total = sum(e["kinetic"].values()) + sum(e["strain"].values())
         works = sum(sum(e[k].values()) for k in ("external_work", "coupling_work",

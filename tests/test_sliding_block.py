@@ -1,0 +1,185 @@
+"""Coulomb friction in the level-set contact model: the sliding block against its exact solutions.
+
+Exact (a rigid block, the mean velocity = momentum / mass): under a top pressure p, launched at
+v0, the block decelerates at a = μ p / (ρ H) and stops at v0 / a; on an incline θ under gravity
+it sticks for tan θ < μ and slides at g (sin θ − μ cos θ) for tan θ > μ. The elastic block
+vibrates about these (the shear waves of the friction onset), so the checks are on time
+averages (fits and moving means) over the run.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+import skfem
+
+from arlequin.cli import main
+from arlequin.demos.sliding_block import JSON_KEYS, run_sliding_block
+from arlequin.integrators import solve
+from arlequin.models import (
+    ContactSurface,
+    CoulombContact,
+    DeformableContactPair,
+    IsotropicElastic,
+    LinearElastic,
+    PlaneObstacle,
+    RigidContactPair,
+)
+from arlequin.models.friction import tangents
+from arlequin.system import Block, BlockTerm, CoupledSystem
+
+MU = 0.3
+
+
+@pytest.fixture(scope="module")
+def plane_strain(tmp_path_factory):
+    out = tmp_path_factory.mktemp("sliding") / "run"
+    return run_sliding_block(dim=2, friction=MU, out=out), out
+
+
+@pytest.fixture(scope="module")
+def block_3d():
+    return run_sliding_block(dim=3, friction=MU)
+
+
+def test_plane_strain_block_decelerates_at_the_exact_rate_and_stops(plane_strain):
+    r, _ = plane_strain
+    # measured: rate −4e-6, stop +0.63% (the moving mean over one shear period falls below
+    # 1e-3 v0), energy balance 2.0e-4, 1.82 fixed-point iterations per step (max 2)
+    assert r.expected_acceleration == pytest.approx(-MU * 1e5 / (7850.0 * 0.01), rel=1e-12)
+    assert r.acceleration == pytest.approx(r.expected_acceleration, rel=0.01)
+    assert r.stop_time == pytest.approx(r.expected_stop_time, rel=0.01)
+    assert r.energy_balance_error < 0.01
+    assert r.fixed_point_iterations["mean"] <= 10
+    # friction only removes energy over the run, and the normal contact little
+    assert r.friction_work[-1] < 0.0
+    assert abs(r.friction_work[-1]) == pytest.approx(0.5 * 7850.0 * 0.02 * 0.01, rel=0.01)
+
+
+def test_3d_block_decelerates_at_the_exact_rate_and_stops(block_3d):
+    r = block_3d
+    # measured: rate −8.7e-4, energy balance 1.4e-4, 2.0 iterations per step; the stop is
+    # within 5% (+3.0%), the 1% of the next test is not met
+    assert r.acceleration == pytest.approx(r.expected_acceleration, rel=0.01)
+    assert r.stop_time == pytest.approx(r.expected_stop_time, rel=0.05)
+    assert r.energy_balance_error < 0.01
+    assert r.fixed_point_iterations["mean"] <= 10
+
+
+@pytest.mark.xfail(strict=True, reason="measured: +3.0%: the last 3% of the velocity decays "
+                   "slowly as the base sticks and slips by turns (4 cells across)")
+def test_3d_block_stops_within_one_percent(block_3d):
+    assert block_3d.stop_time == pytest.approx(block_3d.expected_stop_time, rel=0.01)
+
+
+@pytest.mark.xfail(strict=True, reason="measured: slip events of up to 9.7e-4 v0 go on after "
+                   "the stop (corner nodes, as the launch's vibrations decay)")
+def test_contact_nodes_stick_after_the_stop(plane_strain):
+    r, _ = plane_strain
+    assert r.max_slip_after_stop <= 1e-6 * 1.0
+
+
+@pytest.mark.xfail(strict=True, reason="measured: 84 of 13800 steps have a positive friction "
+                   "work increment (the trapezoidal attribution across a velocity reversal)")
+def test_friction_dissipation_is_never_negative(plane_strain):
+    r, _ = plane_strain
+    assert r.negative_dissipation_steps == 0
+
+
+def test_results_folder_and_interface_keys(plane_strain):
+    r, out = plane_strain
+    data = r.to_json()
+    assert list(data)[: len(JSON_KEYS)] == list(JSON_KEYS)
+    assert len(data["t"]) <= 2000 and len(data["t"]) == len(data["mean_velocity"])
+    meta = json.loads((out / "results.json").read_text())
+    assert meta["status"] == "complete"
+    assert meta["inputs"]["pressure"]["unit"] == "Pa"
+    for name in ("sliding.csv", "history.csv", "sliding_block.png", "fields/block.xdmf"):
+        assert (out / name).stat().st_size > 0
+
+
+@pytest.mark.parametrize("offset, slides", [(-0.5, False), (0.5, True)])
+def test_incline_transition_within_half_a_degree(offset, slides):
+    theta = math.degrees(math.atan(MU)) + offset
+    r = run_sliding_block(friction=MU, velocity=0.0, gravity=1e5, incline=theta, t_end=1e-3)
+    width = 0.02
+    if slides:
+        assert r.sliding_distance > 1e-3 * width
+    else:
+        # measured 1.1e-9 m: no creep
+        assert abs(r.sliding_distance) <= 1e-6 * width
+        assert r.energy_balance_error < 0.01
+
+
+def test_incline_sliding_acceleration():
+    theta = math.degrees(math.atan(MU)) + 5.0
+    r = run_sliding_block(friction=MU, velocity=0.0, gravity=1e5, incline=theta, t_end=1e-3)
+    th = math.radians(theta)
+    assert r.expected_acceleration == pytest.approx(1e5 * (math.sin(th) - MU * math.cos(th)))
+    # measured 2e-6 over 2 ms
+    assert r.acceleration == pytest.approx(r.expected_acceleration, rel=0.01)
+    assert r.energy_balance_error < 0.01
+
+
+def test_frictionless_block_keeps_its_velocity():
+    # no tangential force at all: the momentum along x is that of the launch to round-off
+    # (measured 7e-12 m/s after 900 steps: the internal forces, of the size of p W, sum to zero
+    # to round-off at each step)
+    r = run_sliding_block(friction=0.0, t_end=2e-4)
+    assert np.allclose(r.mean_velocity, 1.0, rtol=0.0, atol=1e-10)
+    assert r.friction_work[-1] == 0.0
+
+
+def test_tangents_are_orthonormal_to_the_normal():
+    rng = np.random.default_rng(3)
+    n = rng.standard_normal((3, 50))
+    n /= np.linalg.norm(n, axis=0)
+    t = tangents(n)
+    for a in range(2):
+        assert np.allclose(np.sum(t[a] * n, axis=0), 0.0, atol=1e-14)
+        assert np.allclose(np.linalg.norm(t[a], axis=0), 1.0)
+    assert np.allclose(np.sum(t[0] * t[1], axis=0), 0.0, atol=1e-14)
+    t2 = tangents(np.array([[0.0], [1.0]]))  # a wall z = 0 in (r, z): the radial direction
+    assert np.allclose(t2[0, :, 0], [1.0, 0.0])
+
+
+def _square(mat):
+    mesh = skfem.MeshQuad.init_tensor(np.linspace(0, 1, 3), np.linspace(0, 1, 3))
+    model = LinearElastic(mesh, mat, kind="plane_strain")
+    system = CoupledSystem([Block("block", model, [BlockTerm(model)])])
+    surf = ContactSurface(mesh, where=lambda x: x[1] < 1e-9, offset=system.dofmap["block"])
+    return mesh, system, surf
+
+
+def test_bad_input_is_refused():
+    mat = IsotropicElastic(1e9, 0.3, 1e3)
+    _, system, surf = _square(mat)
+    pair = RigidContactPair(surf, PlaneObstacle(np.zeros(2), np.array([0.0, 1.0])),
+                            system.dofmap)  # fmt: skip
+    with pytest.raises(ValueError, match="friction coefficient must be positive"):
+        CoulombContact(pair, 0.0, material=mat)
+    deformable = DeformableContactPair(surf, surf, system.dofmap)
+    with pytest.raises(ValueError, match="rigid obstacles"):
+        CoulombContact(deformable, 0.3, material=mat)
+    con = CoulombContact(pair, 0.3, material=mat)
+    with pytest.raises(ValueError, match="explicit integrator"):
+        solve(system, "newmark", n_steps=1, dt=1e-6, constraints=[con])
+    for kwargs, match in (({"pressure": 1e5, "gravity": 10.0}, "one of pressure and gravity"),
+                          ({"incline": 10.0}, "needs the gravity"),
+                          ({"gravity": 10.0}, "pressure loading only"),
+                          ({"friction": -0.1}, "friction must be"),
+                          ({"dim": 1}, "dim must be 2 or 3")):  # fmt: skip
+        with pytest.raises(ValueError, match=match):
+            run_sliding_block(**kwargs)
+
+
+def test_cli_writes_the_interface_json(tmp_path):
+    path = tmp_path / "sb.json"
+    code = main(["sliding-block", "--quiet", "--t-end", "1e-4", "--json", str(path)])
+    assert code == 0
+    data = json.loads(path.read_text())
+    assert set(JSON_KEYS) <= set(data) and data["friction"] == MU
+    assert main(["sliding-block", "--quiet", "--incline", "10"]) == 2
