@@ -48,7 +48,7 @@ from .base import Integrator
 from .controllers import FixedStep, StepController
 from .impulses import ImpulseSolver
 from .registry import register
-from .rows import unilateral_block_power
+from .rows import transposed, unilateral_block_power
 from .stability import DEFAULT_SAFETY, StableStep, check_time_step, stable_time_step
 
 __all__ = ["DEFAULT_SAFETY", "CentralDifference"]
@@ -251,7 +251,7 @@ class CentralDifference(Integrator):
             if rows.m:
                 v_new[rows.cols] -= minv[rows.cols] * (rows.matrix_cols_t @ lam_e)
             if g_a.shape[0]:
-                v_new -= minv * (g_a.T @ lam_a)
+                v_new -= minv * (transposed(g_a) @ lam_a)
             fulls = self._full_multipliers(lam_a / dt_bar, idx)
             if f_app is not None:
                 fulls = [f if a is None else f + a for f, a in zip(fulls, applied)]
