@@ -55,6 +55,7 @@ def _add_patch_test(sub) -> None:
         help="uniform-stress patch test of a random coarse + patch configuration",
         description="Build a random configuration from the seed, solve the uniform-stress "
         "problem and report max_error and exact_residual (fractions).",
+        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
     )
     p.add_argument("--dim", choices=["1", "2", "3", "axi"], default="2")
     p.add_argument("--coupling", choices=["L2", "H1"], default="H1")
@@ -113,6 +114,7 @@ def _add_two_bars(sub) -> None:
         help="impact of two elastic bars: level-set contact vs Newmark + Signorini vs exact",
         description="Bar 1 at --velocity hits bar 2 (touching at t = 0); SI units. Reports the "
         "interface velocity, contact pressure (-lambda_v), energies and contact work.",
+        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
     )
     p.add_argument("--method", choices=["levelset", "newmark", "both"], default="levelset")
     p.add_argument("--newmark", choices=["trapezoidal", "hht"], default="trapezoidal")
@@ -179,6 +181,7 @@ def _add_wave(sub) -> None:
         description="A smooth right-going pulse in a coarse bar meets a refined patch glued at "
         "its left end; the reflection is measured against a single coarse-mesh run with the same "
         "integrator and time step (fractions of the incident energy).",
+        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
     )
     p.add_argument("--ratio", type=int, default=4, help="coarse/fine element size ratio")
     p.add_argument("--pulse-width", type=float, default=10.0, help="in coarse elements")
