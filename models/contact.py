@@ -193,7 +193,7 @@ class _ContactConstraint:
         one linearised when ``update_geometry`` is False."""
         if not self.update_geometry:
             gap = self._geo0.gap + self._geo0.rows @ (u - self._u0)
-            return ContactGeometry(self._geo0.rows, gap, self._geo0.normal)
+            return ContactGeometry(self._geo0.rows, gap, self._geo0.normal, self._geo0.jump)
         return self.pair.geometry(u)
 
     def _geometry_from(self, state: ContactState, u: np.ndarray) -> ContactGeometry:

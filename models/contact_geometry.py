@@ -170,11 +170,17 @@ class ContactGeometry:
         d_n (m), negative when apart.
     normal : ndarray, shape (dim, m)
         Contact normal (unit), pointing from the obstacle/master into the slave side.
+    jump : callable, optional
+        ``jump(e)`` for directions e (dim, m): the rows (m, n) of v ↦ e_k·(v_s − v_m) at each
+        point, the slave's velocity relative to the obstacle (0) or to the master point it is
+        paired with in this configuration (``rows`` is ``jump(−normal)``). Friction uses it with
+        the tangents.
     """
 
     rows: sp.csr_matrix
     gap: np.ndarray
     normal: np.ndarray
+    jump: Callable[[np.ndarray], sp.csr_matrix] | None = None
 
 
 class ContactPair:
@@ -241,7 +247,12 @@ class RigidContactPair(ContactPair):
                 (vals, (self._r, self._c)), shape=(self.slave.n_points, self.n_dofs)
             )
             self._rows_cache = (n.copy(), rows)
-        return ContactGeometry(rows, -phi, n)
+        r, c, shape = self._r, self._c, (self.slave.n_points, self.n_dofs)
+
+        def jump(e: np.ndarray) -> sp.csr_matrix:
+            return sp.csr_matrix((np.asarray(e).T.ravel(), (r, c)), shape=shape)
+
+        return ContactGeometry(rows, -phi, n, jump)
 
 
 class DeformableContactPair(ContactPair):
@@ -325,7 +336,15 @@ class DeformableContactPair(ContactPair):
         vals = np.concatenate([v_s, v_m.ravel()])
         ij = (np.concatenate([r_s, r_m]), np.concatenate([c_s, c_m.ravel()]))
         rows = sp.csr_matrix((vals, ij), shape=(m, self.n_dofs))
-        return ContactGeometry(rows, gap, n)
+        n_dofs = self.n_dofs
+
+        def jump(e: np.ndarray) -> sp.csr_matrix:
+            # e·v_s − Σ_j N_j e·v_j at each slave point
+            e = np.asarray(e)
+            vals = np.concatenate([e.T.ravel(), (-shape[:, :, None] * e.T[:, None, :]).ravel()])
+            return sp.csr_matrix((vals, ij), shape=(m, n_dofs))
+
+        return ContactGeometry(rows, gap, n, jump)
 
 
 def _closest_on_triangles(p: np.ndarray, xf: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -18,8 +18,9 @@ vertex rule: the rows are ``B_t = −W G_t`` and the force on the bodies is ``�
 Sign conventions: the tangents t_j (j < dim − 1) are unit vectors orthogonal to the contact
 normal n (2D and axisymmetric: t = (n_y, −n_x), the radial direction on a wall z = 0; 3D: an
 orthonormal pair, t_1 ⟂ n and the coordinate axis least aligned with n, t_2 = n × t_1);
-[[v_t]]_j = t_j·v; the force on the slave is w λ_t along t, opposite to the slip (λ_t·[[v_t]] ≤ 0
-when sliding, so that the dissipation D_f = −∫ λ_t·[[v_t]] dΓ dt ≥ 0).
+[[v_t]]_j = t_j·(v_s − v_m) (v_m = 0 against an obstacle); the force on the slave is w λ_t
+along t (its reaction on the master), opposite to the slip (λ_t·[[v_t]] ≤ 0 when sliding, so
+that the dissipation D_f = −∫ λ_t·[[v_t]] dΓ dt ≥ 0).
 
 The fixed point of each step iterates on (S_d, S_v, S_t) and the slip tractions together: after
 each solve, the normal statuses are updated as in the frictionless model; a point that stays in
@@ -33,10 +34,11 @@ Friction work is accumulated from the multipliers like the normal contact work (
 the tangential multipliers, stick and slip, times the mean of the velocities before and after
 it), reported as ``friction_work`` (J, ≤ 0: minus the dissipation).
 
-Supported: rigid obstacles (:class:`RigidContactPair`), 2D, axisymmetric (the points on the
+Supported: rigid obstacles (:class:`RigidContactPair`) and deformable pairs
+(:class:`DeformableContactPair`: [[v_t]] is the slave's velocity relative to the master point it
+is paired with, the tangents those of the master's normal), 2D, axisymmetric (the points on the
 axis carry no friction row: their radial velocity is zero by symmetry) and 3D, with the
-explicit integrator (slip tractions are applied forces; ``explicit_only``). Deformable pairs
-are refused with a clear error.
+explicit integrator (slip tractions are applied forces; ``explicit_only``).
 """
 
 from __future__ import annotations
@@ -126,7 +128,7 @@ class CoulombContact(LevelSetContact):
 
     Parameters
     ----------
-    pair : RigidContactPair
+    pair : RigidContactPair or DeformableContactPair
     friction : float
         Coulomb coefficient μ > 0.
     kappa, eta : float, optional
@@ -153,11 +155,6 @@ class CoulombContact(LevelSetContact):
         slip_tolerance: float = 1e-10,
         **kwargs: Any,
     ) -> None:
-        if not isinstance(pair, RigidContactPair):
-            raise ValueError(
-                f"friction is implemented against rigid obstacles (RigidContactPair), got a "
-                f"{type(pair).__name__}"
-            )
         if pair.slave.dim not in (2, 3):
             raise ValueError(f"friction needs a 2D or 3D surface, got dim={pair.slave.dim}")
         if not (np.isfinite(friction) and friction > 0.0):
@@ -177,9 +174,6 @@ class CoulombContact(LevelSetContact):
         if getattr(pair.slave, "axisymmetric", False):
             r = pair.slave.positions(np.zeros(pair.n_dofs))[0]
             self._frictional = r > 1e-12 * max(float(np.abs(r).max()), 1e-300)
-        node_dofs = pair.slave.node_dofs(pair.slave.nodes)  # (dim, m)
-        self._t_rows = np.arange(self.n_tangents * m)
-        self._t_cols = node_dofs
         self._t_cache: tuple[np.ndarray, sp.csr_matrix] | None = None
         self._stack_cache: tuple[Any, Any, sp.csr_matrix] | None = None
 
@@ -191,16 +185,13 @@ class CoulombContact(LevelSetContact):
     def tangential_rows(self, geo: ContactGeometry) -> sp.csr_matrix:
         """G_t: v ↦ [[v_t]] at the points, shape ((dim − 1) m, n), row j m + k."""
         cached = self._t_cache
-        if cached is not None and np.array_equal(cached[0], geo.normal):
-            return cached[1]
-        t = tangents(geo.normal)  # (nt, dim, m)
-        nt, dim, m = t.shape
-        vals = t * self._frictional[None, None, :]
-        rows = np.repeat(np.arange(nt * m).reshape(nt, 1, m), dim, axis=1)
-        cols = np.broadcast_to(self._t_cols[None], (nt, dim, m))
-        g = sp.csr_matrix(
-            (vals.ravel(), (rows.ravel(), cols.ravel())), shape=(nt * m, self.pair.n_dofs)
-        )
+        rigid = isinstance(self.pair, RigidContactPair)
+        if rigid and cached is not None and np.array_equal(cached[0], geo.normal):
+            return cached[1]  # a rigid pair's rows depend on its normals only
+        if geo.jump is None:
+            raise ValueError("the contact pair gives no velocity-jump rows (ContactGeometry.jump)")
+        t = tangents(geo.normal) * self._frictional[None, None, :]  # (nt, dim, m)
+        g = sp.vstack([geo.jump(t[j]) for j in range(t.shape[0])], format="csr")
         self._t_cache = (geo.normal.copy(), g)
         return g
 
