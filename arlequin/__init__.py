@@ -103,3 +103,14 @@ __all__ = [
     "solve",
     "solve_static",
 ]
+
+
+def __getattr__(name: str):
+    """``arlequin.study``: the study runner, which lives with the demos it runs
+    (:func:`arlequin.demos.study.study`), loaded on first use so that the core does not import
+    the demos."""
+    if name == "study":
+        from importlib import import_module
+
+        return import_module("arlequin.demos.study").study
+    raise AttributeError(f"module 'arlequin' has no attribute {name!r}")

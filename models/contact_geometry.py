@@ -247,11 +247,7 @@ class RigidContactPair(ContactPair):
                 (vals, (self._r, self._c)), shape=(self.slave.n_points, self.n_dofs)
             )
             self._rows_cache = (n.copy(), rows)
-        r, c, shape = self._r, self._c, (self.slave.n_points, self.n_dofs)
-
-        def jump(e: np.ndarray) -> sp.csr_matrix:
-            return sp.csr_matrix((np.asarray(e).T.ravel(), (r, c)), shape=shape)
-
+        jump = _JumpRows((self._r, self._c), (self.slave.n_points, self.n_dofs))
         return ContactGeometry(rows, -phi, n, jump)
 
 
@@ -336,15 +332,28 @@ class DeformableContactPair(ContactPair):
         vals = np.concatenate([v_s, v_m.ravel()])
         ij = (np.concatenate([r_s, r_m]), np.concatenate([c_s, c_m.ravel()]))
         rows = sp.csr_matrix((vals, ij), shape=(m, self.n_dofs))
-        n_dofs = self.n_dofs
+        return ContactGeometry(rows, gap, n, _JumpRows(ij, (m, self.n_dofs), shape))
 
-        def jump(e: np.ndarray) -> sp.csr_matrix:
-            # e·v_s − Σ_j N_j e·v_j at each slave point
-            e = np.asarray(e)
-            vals = np.concatenate([e.T.ravel(), (-shape[:, :, None] * e.T[:, None, :]).ravel()])
-            return sp.csr_matrix((vals, ij), shape=(m, n_dofs))
 
-        return ContactGeometry(rows, gap, n, jump)
+@dataclass(frozen=True)
+class _JumpRows:
+    """``jump(e)`` of a :class:`ContactGeometry`: the rows of e_k·(v_s − Σ_j N_j v_j) at each
+    point, on the pattern ``ij`` of the normal rows (slave dofs, then the master's, whose shape
+    values are ``master_shape`` (m, n_v); None against an obstacle). A picklable object, so
+    that constraint states with their geometry go into checkpoints."""
+
+    ij: tuple[np.ndarray, np.ndarray]
+    shape: tuple[int, int]
+    master_shape: np.ndarray | None = None
+
+    def __call__(self, e: np.ndarray) -> sp.csr_matrix:
+        e = np.asarray(e)
+        vals = e.T.ravel()
+        if self.master_shape is not None:
+            vals = np.concatenate(
+                [vals, (-self.master_shape[:, :, None] * e.T[:, None, :]).ravel()]
+            )
+        return sp.csr_matrix((vals, self.ij), shape=self.shape)
 
 
 def _closest_on_triangles(p: np.ndarray, xf: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
