@@ -12,7 +12,7 @@ from .cli_common import write_json as _write_json
 from .cli_sliding import add_sliding_block
 from .cli_taylor import add_taylor_bar
 
-__all__ = ["add_demos", "demo_parser"]
+__all__ = ["add_demos", "demo_parser", "wave_options"]
 
 
 def add_demos(sub) -> None:
@@ -157,22 +157,19 @@ def _add_two_bars(sub) -> None:
     p.set_defaults(func=_cmd_two_bars)
 
 
+def wave_options(args: argparse.Namespace) -> dict:
+    """The keyword arguments of :func:`~arlequin.demos.wave.run_wave` that the command line
+    gives (all but ``out`` and ``progress``)."""
+    return dict(ratio=args.ratio, pulse_width=args.pulse_width, gluing_width=args.gluing_width,
+                coupling=args.coupling, mediator=args.mediator, weights=args.weights,
+                integrator=args.integrator, dt=args.dt)  # fmt: skip
+
+
 def _cmd_wave(args: argparse.Namespace) -> int:
     from .demos.wave import plot_wave, run_wave
 
     with progress_bar(100.0, "%", args.quiet, scale=100.0, label="coupled run") as update:
-        result = run_wave(
-            ratio=args.ratio,
-            pulse_width=args.pulse_width,
-            gluing_width=args.gluing_width,
-            coupling=args.coupling,
-            mediator=args.mediator,
-            weights=args.weights,
-            integrator=args.integrator,
-            dt=args.dt,
-            out=args.out,
-            progress=update,
-        )
+        result = run_wave(out=args.out, progress=update, **wave_options(args))
     print(result.summary())
     _write_json(args.json, result.to_json())
     if args.plot:

@@ -20,12 +20,14 @@ def _cmd(args: argparse.Namespace) -> int:
         print(f"\rcases: {done}/{total} done, {running} to go, {failed} failed{left}   ",
               end="", file=sys.stderr, flush=True)  # fmt: skip
 
+    def announce(link: str | None) -> None:
+        if link:
+            print(f"Dask dashboard: {link}", flush=True)
+
     run = study(args.spec, out=args.out, scheduler=args.scheduler, workers=args.workers,
-                resume=args.resume, progress=progress)  # fmt: skip
+                resume=args.resume, progress=progress, on_cluster=announce)  # fmt: skip
     if not quiet:
         print(file=sys.stderr)
-    if run.dashboard:
-        print(f"Dask dashboard was at {run.dashboard}")
     print(f"study {run.out}: {len(run.ran)} cases run, {len(run.skipped)} already complete, "
           f"{len(run.failed)} failed; table in {run.out / 'results.csv'}")  # fmt: skip
     for case, reason in run.failed.items():

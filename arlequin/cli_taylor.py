@@ -9,7 +9,7 @@ import argparse
 
 from .cli_common import add_out, progress_bar, write_json
 
-__all__ = ["add_taylor_bar"]
+__all__ = ["add_taylor_bar", "run_options"]
 
 
 #: Options that may come with ``--resume`` (the inputs come from the checkpoint).
@@ -35,11 +35,9 @@ def _cmd_resume(args: argparse.Namespace) -> int:
     return 0
 
 
-def _cmd_taylor_bar(args: argparse.Namespace) -> int:
-    from .demos.taylor_bar import run_taylor_bar
-
-    if args.resume:
-        return _cmd_resume(args)
+def run_options(args: argparse.Namespace) -> dict:
+    """The keyword arguments of :func:`~arlequin.demos.taylor_bar.run_taylor_bar` that the
+    command line gives (all but ``out`` and ``progress``)."""
     laws = ("voce_saturation", "voce_rate", "jc_b", "jc_n", "jc_c", "jc_reference_rate")
     law_params = {k: getattr(args, k) for k in laws if getattr(args, k) is not None}
     # the Arlequin options given on the command line (run_taylor_bar refuses those that do not
@@ -47,31 +45,24 @@ def _cmd_taylor_bar(args: argparse.Namespace) -> int:
     names = ("patch_length", "gluing_width", "coarse_size", "fine_size", "weights", "mediator",
              "coupling", "coarse_step_ratio", "band_warning")  # fmt: skip
     arlequin = {k: getattr(args, k) for k in names if getattr(args, k) is not None}
+    return dict(
+        model=args.model, elements_radial=args.elements_radial, mesh_size=args.mesh_size,
+        friction=args.friction, t_end=args.t_end, velocity=args.velocity, young=args.young,
+        poisson=args.poisson, density=args.density, yield_stress=args.yield_stress,
+        hardening=args.hardening, hardening_law=args.hardening_law, length=args.length,
+        radius=args.radius, bulk_viscosity=args.bulk_viscosity, fbar=not args.no_fbar,
+        backend=args.backend, **arlequin, **law_params,
+    )  # fmt: skip
+
+
+def _cmd_taylor_bar(args: argparse.Namespace) -> int:
+    from .demos.taylor_bar import run_taylor_bar
+
+    if args.resume:
+        return _cmd_resume(args)
     with progress_bar(args.t_end * 1e6, "µs", args.quiet, scale=1e6,
                       label="simulated time") as update:  # fmt: skip
-        result = run_taylor_bar(
-            model=args.model,
-            elements_radial=args.elements_radial,
-            mesh_size=args.mesh_size,
-            friction=args.friction,
-            t_end=args.t_end,
-            velocity=args.velocity,
-            young=args.young,
-            poisson=args.poisson,
-            density=args.density,
-            yield_stress=args.yield_stress,
-            hardening=args.hardening,
-            hardening_law=args.hardening_law,
-            length=args.length,
-            radius=args.radius,
-            bulk_viscosity=args.bulk_viscosity,
-            fbar=not args.no_fbar,
-            backend=args.backend,
-            out=args.out,
-            progress=update,
-            **arlequin,
-            **law_params,
-        )
+        result = run_taylor_bar(out=args.out, progress=update, **run_options(args))
     print(result.summary())
     write_json(args.json, result.to_json())
     return 0

@@ -143,8 +143,9 @@ def run_taylor_bar(
     progress: Callable[[float], None] | None = None,
     checkpoint_interval: float = 10e-6,
     resume: bool = False,
+    check_only: bool = False,
     **law_parameters: float,
-) -> TaylorBarResult:
+) -> TaylorBarResult | None:
     """Run the Taylor bar impact (see the module docstring).
 
     Parameters
@@ -220,6 +221,9 @@ def run_taylor_bar(
     checkpoint_interval : float
         With ``out``: simulated time (s) between checkpoints (``checkpoint.pkl`` in the
         folder, default 10 µs; removed when the run completes).
+    check_only : bool
+        Check every input and build the models, then return None without running or writing
+        anything (a study checks its cases so before running any).
     resume : bool
         Continue the interrupted run of the folder ``out`` from its last checkpoint (the inputs
         must be the same; :func:`resume_taylor_bar` reads them from the checkpoint). Everything
@@ -330,6 +334,8 @@ def run_taylor_bar(
     else:
         bar = MonoBar(length, radius, n_r, material, fbar, backend, visc, friction=friction)
         n_z = bar.mesh.t.shape[1] // n_r
+    if check_only:  # every input checked, the models built: nothing run, nothing written
+        return None
     fine_model = bar.model
     config.update({
         "elements_radial": n_r, "elements_axial": n_z, "mesh_size": radius / n_r,

@@ -164,7 +164,8 @@ def run_wave(
     length: float | None = None,
     out: str | Path | None = None,
     progress: Callable[[float], None] | None = None,
-) -> WaveResult:
+    check_only: bool = False,
+) -> WaveResult | None:
     """Run the 1D wave demo (see the module docstring).
 
     Parameters
@@ -196,6 +197,8 @@ def run_wave(
     progress : callable, optional
         ``progress(fraction)`` with the fraction of the coupled run's steps done, about 200
         times over the run (the CLI's progress bar).
+    check_only : bool
+        Check every input and return None without running or writing anything.
 
     Returns
     -------
@@ -222,6 +225,8 @@ def run_wave(
               "integrator": integrator, "dt": dt, "epsilon": epsilon, "length": length}  # fmt: skip
     units = {"ratio": "1", "pulse_width": "coarse elements", "gluing_width": "coarse elements",
              "dt": "s", "epsilon": "1", "length": "coarse elements"}  # fmt: skip
+    if check_only:  # every input checked: nothing run, nothing written
+        return None
     folder = ResultsFolder(out, "arlequin wave", inputs, units) if out is not None else None
     lay = wave_layout(pulse_width, gluing_width)
     n_c = round(lay["length"])
