@@ -21,7 +21,7 @@ def _cmd(args: argparse.Namespace) -> int:
               end="", file=sys.stderr, flush=True)  # fmt: skip
 
     def announce(link: str | None) -> None:
-        if link:
+        if link and not args.quiet:
             print(f"Dask dashboard: {link}", flush=True)
 
     run = study(args.spec, out=args.out, scheduler=args.scheduler, workers=args.workers,
@@ -48,11 +48,11 @@ def add_study(sub) -> None:
     )
     p.add_argument("spec", metavar="SPEC", help="the study file (TOML)")
     p.add_argument("--scheduler", metavar="ADDRESS", default=None,
-                   help="a running Dask scheduler (default: a local cluster)")
+                   help="a running Dask scheduler; without it, a local cluster")
     p.add_argument("--workers", type=int, default=None, metavar="N",
-                   help="workers of the local cluster (default: the machine's cores)")
+                   help="workers of the local cluster; without it, one per core")
     p.add_argument("--out", metavar="DIR", default="study", help="the study folder")
     p.add_argument("--resume", action=argparse.BooleanOptionalAction, default=True,
                    help="skip the cases already complete in --out")
-    p.add_argument("--quiet", action="store_true", help="no progress line")
+    p.add_argument("--quiet", action="store_true", help="no progress line, no dashboard link")
     p.set_defaults(func=_cmd)

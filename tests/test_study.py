@@ -42,6 +42,8 @@ def test_the_minimal_spec_has_the_cartesian_product(tmp_path):
     ({"demo": "taylor-bar", "parameters": {"model": "mono", "mediator": "coarse"}},
      "apply to model='arlequin' only"),
     ({"demo": "wave", "parameters": {"ratio": 0}}, "ratio must be a positive integer"),
+    ({"demo": "two-bars", "parameters": {"velocity": -1.0}}, "bar 1 must approach bar 2"),
+    ({"demo": "two-bars", "parameters": {"lengths": 1.0}}, "'lengths'.*takes 2 values"),
     ({"demo": "two-bars", "parameters": {"velocity": []}}, "'velocity' has an empty list"),
     ({"demo": "two-bars", "parameters": {"out": "x"}}, "'out' is set by the study"),
     ({"demo": "two-bars", "extra": 1}, r"unknown keys \['extra'\]"),
@@ -63,6 +65,8 @@ def test_a_local_cluster_gives_the_serial_numbers_bit_for_bit(tmp_path):
         serial = run_case("two-bars", case.params, tmp_path / "serial" / case.case_id)
         parallel = index[case.case_id]["results"]
         assert comparable(parallel) == comparable(serial)
+        # the demo's metrics of its results folder are in the table too
+        assert {"pressure_rms_error", "contact_duration"} <= set(parallel)
         # and every computed value of the case's JSON (histories included), bit for bit
         docs = [json.loads((root / case.case_id / "case.json").read_text())
                 for root in (tmp_path / "dask" / "cases", tmp_path / "serial")]  # fmt: skip
@@ -87,6 +91,12 @@ def test_a_rerun_skips_the_completed_cases(tmp_path):
     resumed = study(data, out=tmp_path / "s", workers=2)
     assert resumed.ran == [victim] and len(resumed.skipped) == 2
     assert len((tmp_path / "s" / "results.csv").read_text().splitlines()) == 4
+    # a grown grid runs its new cases only; another study in the same folder is refused
+    grown = {"demo": "two-bars", "parameters": {"velocity": [1.0, 2.0, 3.0, 4.0], "elements": 20}}
+    assert len(study(grown, out=tmp_path / "s", workers=2).ran) == 1
+    other = {"demo": "two-bars", "parameters": {"velocity": [1.0, 2.0], "elements": 30}}
+    with pytest.raises(StudyError, match="holds another study"):
+        study(other, out=tmp_path / "s")
 
 
 CASES = '''

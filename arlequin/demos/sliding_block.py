@@ -158,6 +158,14 @@ class SlidingBlockResult(JsonResult):
 
     def summary(self) -> str:
         """One line: acceleration, stop time, energy error, iterations."""
+        if self.config.get("gravity") is not None:
+            moved = abs(self.sliding_distance) > 1e-6 * float(self.config.get("width", 0.02))
+            return (f"sliding block on a {self.config.get('incline')}° incline: it "
+                    f"{'slides' if moved else 'sticks'} (sliding distance "
+                    f"{self.sliding_distance:.3e} m), acceleration {self.acceleration:.6e} m/s^2 "
+                    f"(exact {self.expected_acceleration:.6e}), energy balance "
+                    f"{self.energy_balance_error:.2e}, fixed point "
+                    f"{self.fixed_point_iterations['mean']:.2f} iterations per step")  # fmt: skip
         stop = "none" if self.stop_time is None else f"{self.stop_time:.6e} s"
         exp = "" if self.expected_stop_time is None else f" (exact {self.expected_stop_time:.6e})"
         return (f"sliding block: acceleration {self.acceleration:.6e} m/s^2 (exact "

@@ -124,7 +124,20 @@ def run_case(demo: str, params: Mapping[str, Any], out: str | os.PathLike,
         data["warnings"] = "; ".join(sorted({f"{w.category.__name__}: {w.message}"
                                              for w in caught}))  # fmt: skip
         (out / "case.json").write_text(json.dumps(data, indent=2))
-    return _scalars(json.loads((out / "case.json").read_text()))
+    return _case_results(out, params)
+
+
+def _case_results(out: Path, params: Mapping[str, Any]) -> dict[str, Any]:
+    """The case's scalar results: those of its JSON and of its results folder's
+    ``results.json`` (the demo's metrics with their units), without its own parameters."""
+    results = _scalars(json.loads((out / "case.json").read_text()))
+    meta = out / "run" / "results.json"
+    if meta.exists():
+        for k, v in json.loads(meta.read_text()).get("results", {}).items():
+            value = v.get("value") if isinstance(v, Mapping) else v
+            if isinstance(value, (int, float, str, bool)) and k not in results:
+                results[k] = value
+    return {k: v for k, v in results.items() if k not in params}
 
 
 def _task(demo: str, params: dict, out: str, numba_threads: int) -> dict[str, Any]:
@@ -237,6 +250,16 @@ def study(spec: str | os.PathLike | Mapping[str, Any], out: str | os.PathLike = 
         (root / "cases").mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise StudyError(f"cannot write the study folder {str(root)!r}: {exc}") from exc
+    old_index = root / "index.json"
+    if old_index.exists():
+        old = json.loads(old_index.read_text())
+        ours = {c.case_id for c in parsed.cases}
+        others = sorted(set(old.get("cases", {})) - ours)
+        if old.get("demo") != parsed.demo or others:
+            raise StudyError(
+                f"the study folder {str(root)!r} holds another study ({old.get('demo')!r}, "
+                f"{len(others)} cases not in this one): give another out, or remove the folder"
+            )
     index = _Index(root, parsed)
     todo, skipped = [], []
     for c in parsed.cases:

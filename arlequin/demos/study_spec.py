@@ -98,6 +98,11 @@ def _check_case(demo: str, params: Mapping[str, Any], parser) -> None:
             raise StudyError(f"parameter {key!r} of {demo!r} takes {kind}, got {value!r}")
         if isinstance(value, bool):
             continue
+        if isinstance(action.nargs, int) and action.nargs > 1 and not (
+            isinstance(value, (list, tuple)) and len(value) == action.nargs
+        ):
+            raise StudyError(f"parameter {key!r} of {demo!r} takes {action.nargs} values "
+                             f"(a list of {action.nargs}), got {value!r}")  # fmt: skip
         values = value if isinstance(value, (list, tuple)) else [value]
         for v in values:
             try:
@@ -130,14 +135,11 @@ def _check_ranges(demo: str, params: Mapping[str, Any]) -> None:
                    p["gravity"], p["elements"], p["t_end"], 210e9, 0.3, 7850.0, 0.01,
                    0.02)  # fmt: skip
         elif demo == "two-bars":
-            from .two_bars import _check_common
+            from ..cli_demos import _two_bars
+            from .two_bars import run_two_bars
 
-            p = {"young": 210e9, "density": 7850.0, "cfl": 1.0, "elements": 100, "t_end": None,
-                 "theta": 0.5, "velocity": 1.0, "velocity2": 0.0, "lengths": [1.0, 1.0],
-                 **params}  # fmt: skip
-            _check_common(p["young"], p["density"], p["cfl"], p["elements"], p["t_end"],
-                          p["theta"], velocity=p["velocity"], velocity2=p["velocity2"],
-                          length1=p["lengths"][0], length2=p["lengths"][1])  # fmt: skip
+            args = _subparser(demo).parse_args(_argv(demo, params, _subparser(demo))[1:])
+            _two_bars(args, lambda **kw: run_two_bars(**kw, check_only=True), None)
         elif demo in ("taylor-bar", "wave"):
             # the demo's own checks on the case's parsed command line, nothing run
             args = _subparser(demo).parse_args(_argv(demo, params, _subparser(demo))[1:])

@@ -226,7 +226,8 @@ def run_two_bars(
     integrator: str = "theta",
     out: str | Path | None = None,
     progress: Callable[[float], None] | None = None,
-) -> TwoBarsResult:
+    check_only: bool = False,
+) -> TwoBarsResult | None:
     """Impact of two bars touching at t = 0 (see the module docstring).
 
     Parameters
@@ -259,6 +260,8 @@ def run_two_bars(
     progress : callable, optional
         ``progress(fraction)`` with the fraction of the simulated time done (both runs of
         ``method="both"`` together), at each new percent (the CLI's progress bar).
+    check_only : bool
+        Check every input and return None without running or writing anything.
 
     Returns
     -------
@@ -271,6 +274,8 @@ def run_two_bars(
     l1, l2 = (float(x) for x in lengths)
     if not velocity > velocity2:
         raise ValueError(f"bar 1 must approach bar 2: velocity={velocity} <= velocity2={velocity2}")
+    if check_only:
+        return None
     material = IsotropicElastic(young, 0.3, density)
     ex = exact_two_bars((l1, l2), young, density, velocity, velocity2)
     ex["velocity_scale"] = velocity - velocity2
