@@ -33,6 +33,7 @@ def test_the_minimal_spec_has_the_cartesian_product(tmp_path):
 @pytest.mark.parametrize("data, match", [
     ({"demo": "three-bars"}, "demo 'three-bars' is not one of"),
     ({"demo": "two-bars", "parameters": {"speed": 1.0}}, "parameter 'speed' is not an option"),
+    ({"demo": "two-bars", "parameters": {"velocty": 1.0}}, "did you mean 'velocity'"),
     ({"demo": "two-bars", "parameters": {"velocity": "fast"}}, "'velocity'.*not a valid float"),
     ({"demo": "two-bars", "parameters": {"elements": 2.5}}, "'elements'.*not a valid int"),
     ({"demo": "two-bars", "parameters": {"method": "magic"}}, "'method'.*not one of"),

@@ -90,8 +90,13 @@ def _check_case(demo: str, params: Mapping[str, Any], parser) -> None:
         if key in ("json", "out", "quiet", "help", "resume"):
             raise StudyError(f"parameter {key!r} is set by the study itself")
         if key not in opts:
+            import difflib
+
             known = sorted(k for k in opts if k not in ("json", "out", "quiet", "help"))
-            raise StudyError(f"parameter {key!r} is not an option of {demo!r} (options: {known})")
+            close = difflib.get_close_matches(key, known, n=1)
+            hint = f"; did you mean {close[0]!r}?" if close else ""
+            raise StudyError(f"parameter {key!r} is not an option of {demo!r}{hint} "
+                             f"(options: {known})")  # fmt: skip
         action = opts[key]
         if isinstance(value, bool) != (action.nargs == 0):
             kind = "true or false" if action.nargs == 0 else "a value"
