@@ -12,7 +12,7 @@ from .cli_common import write_json as _write_json
 from .cli_sliding import add_sliding_block
 from .cli_taylor import add_taylor_bar
 
-__all__ = ["add_demos", "demo_parser", "wave_options"]
+__all__ = ["add_demos", "check_case", "demo_parser", "two_bars_options", "wave_options"]
 
 
 def add_demos(sub) -> None:
@@ -22,6 +22,30 @@ def add_demos(sub) -> None:
     _add_wave(sub)
     add_taylor_bar(sub)
     add_sliding_block(sub)
+
+
+def check_case(demo: str, args: argparse.Namespace) -> None:
+    """The demo's own input checks on a parsed command line, nothing run or written (its run
+    function with ``check_only=True``; the patch test's options are all choices and integers,
+    which the parser has checked). Raises the demo's ``ValueError``."""
+    if demo == "two-bars":
+        from .demos.two_bars import run_two_bars
+
+        run_two_bars(**two_bars_options(args), check_only=True)
+    elif demo == "wave":
+        from .demos.wave import run_wave
+
+        run_wave(**wave_options(args), check_only=True)
+    elif demo == "taylor-bar":
+        from .cli_taylor import run_options
+        from .demos.taylor_bar import run_taylor_bar
+
+        run_taylor_bar(**run_options(args), check_only=True)
+    elif demo == "sliding-block":
+        from .cli_sliding import sliding_options
+        from .demos.sliding_block import run_sliding_block
+
+        run_sliding_block(**sliding_options(args), check_only=True)
 
 
 def demo_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.ArgumentParser]]:
@@ -88,7 +112,7 @@ def _cmd_two_bars(args: argparse.Namespace) -> int:
     from .demos.two_bars import plot_two_bars, run_two_bars
 
     with progress_bar(100.0, "%", args.quiet, scale=100.0, label="two bars") as update:
-        result = _two_bars(args, run_two_bars, update)
+        result = run_two_bars(out=args.out, progress=update, **two_bars_options(args))
     print(result.summary())
     _write_json(args.json, result.to_json())
     if args.plot:
@@ -96,22 +120,13 @@ def _cmd_two_bars(args: argparse.Namespace) -> int:
     return 0
 
 
-def _two_bars(args: argparse.Namespace, run_two_bars, update):
-    return run_two_bars(
-        method=args.method,
-        newmark=args.newmark,
-        lengths=tuple(args.lengths),
-        young=args.young,
-        density=args.density,
-        velocity=args.velocity,
-        velocity2=args.velocity2,
-        elements=args.elements,
-        cfl=args.cfl,
-        theta=args.theta,
-        t_end=args.t_end,
-        out=args.out,
-        progress=update,
-    )
+def two_bars_options(args: argparse.Namespace) -> dict:
+    """The keyword arguments of :func:`~arlequin.demos.two_bars.run_two_bars` that the command
+    line gives (all but ``out`` and ``progress``)."""
+    return dict(method=args.method, newmark=args.newmark, lengths=tuple(args.lengths),
+                young=args.young, density=args.density, velocity=args.velocity,
+                velocity2=args.velocity2, elements=args.elements, cfl=args.cfl,
+                theta=args.theta, t_end=args.t_end)  # fmt: skip
 
 
 def _add_two_bars(sub) -> None:

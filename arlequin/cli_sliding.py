@@ -6,20 +6,25 @@ import argparse
 
 from .cli_common import add_out, progress_bar, write_json
 
-__all__ = ["add_sliding_block"]
+__all__ = ["add_sliding_block", "sliding_options"]
+
+
+def sliding_options(args: argparse.Namespace) -> dict:
+    """The keyword arguments of :func:`~arlequin.demos.sliding_block.run_sliding_block` that the
+    command line gives (all but ``out`` and ``progress``)."""
+    velocity = args.velocity
+    if velocity is None:
+        velocity = 0.0 if args.gravity is not None else 1.0
+    return dict(dim=args.dim, friction=args.friction, velocity=velocity, incline=args.incline,
+                pressure=args.pressure, gravity=args.gravity, elements=args.elements,
+                t_end=args.t_end)  # fmt: skip
 
 
 def _cmd(args: argparse.Namespace) -> int:
     from .demos.sliding_block import run_sliding_block
 
-    if args.velocity is None:
-        args.velocity = 0.0 if args.gravity is not None else 1.0
     with progress_bar(100.0, "%", args.quiet, scale=100.0, label="sliding block") as update:
-        result = run_sliding_block(
-            dim=args.dim, friction=args.friction, velocity=args.velocity, incline=args.incline,
-            pressure=args.pressure, gravity=args.gravity, elements=args.elements,
-            t_end=args.t_end, out=args.out, progress=update,
-        )  # fmt: skip
+        result = run_sliding_block(out=args.out, progress=update, **sliding_options(args))
     print(result.summary())
     write_json(args.json, result.to_json())
     return 0

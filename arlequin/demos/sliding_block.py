@@ -229,7 +229,8 @@ def run_sliding_block(
     width: float = 0.02,
     out: str | Path | None = None,
     progress: Callable[[float], None] | None = None,
-) -> SlidingBlockResult:
+    check_only: bool = False,
+) -> SlidingBlockResult | None:
     """Run the sliding block (see the module docstring).
 
     Parameters
@@ -258,6 +259,8 @@ def run_sliding_block(
         Results folder (see the module docstring).
     progress : callable, optional
         ``progress(fraction)`` of the simulated time, at each new percent.
+    check_only : bool
+        Check every input and return None without running or writing anything.
 
     Returns
     -------
@@ -267,6 +270,8 @@ def run_sliding_block(
         pressure = 1.0e5
     _check(dim, friction, velocity, incline, pressure, gravity, elements, t_end, young, poisson,
            density, height, width)  # fmt: skip
+    if check_only:
+        return None
     n = int(elements)
     config = {"dim": dim, "friction": friction, "velocity": velocity, "incline": incline,
               "pressure": pressure, "gravity": gravity, "elements": n, "t_end": t_end,

@@ -53,7 +53,6 @@ from .study_spec import (
     StudySpec,
     _argv,
     _resolve,
-    _subparser,
     load_spec,
 )
 
@@ -104,8 +103,8 @@ def run_case(demo: str, params: Mapping[str, Any], out: str | os.PathLike,
 
     from ..cli_demos import demo_parser
 
-    parser, _ = demo_parser()
-    argv = _argv(demo, params, _subparser(demo))
+    parser, commands = demo_parser()
+    argv = _argv(demo, params, commands[demo])
     argv += ["--json", str(out / "case.json"), "--out", str(out / "run")]
     if demo in ("taylor-bar", "sliding-block", "two-bars", "wave"):
         argv.append("--quiet")

@@ -121,45 +121,16 @@ def _check_case(demo: str, params: Mapping[str, Any], parser) -> None:
             if action.choices is not None and converted not in action.choices:
                 raise StudyError(f"parameter {key!r} of {demo!r}: {v!r} is not one of "
                                  f"{list(action.choices)}")  # fmt: skip
-    _check_ranges(demo, params)
+    _check_ranges(demo, params, parser)
 
 
-def _check_ranges(demo: str, params: Mapping[str, Any]) -> None:
-    """The demo's own range checks, where it has them as a function (before any case runs)."""
+def _check_ranges(demo: str, params: Mapping[str, Any], parser) -> None:
+    """The demo's own input checks on the case's parsed command line (before any case runs)."""
+    from ..cli_demos import check_case
+
+    args = parser.parse_args(_argv(demo, params, parser)[1:])
     try:
-        if demo == "sliding-block":
-            from .sliding_block import _check
-
-            p = {"dim": 2, "friction": 0.3, "velocity": None, "incline": 0.0, "pressure": None,
-                 "gravity": None, "elements": 4, "t_end": None, **params}  # fmt: skip
-            if p["velocity"] is None:
-                p["velocity"] = 0.0 if p["gravity"] is not None else 1.0
-            if p["pressure"] is None and p["gravity"] is None:
-                p["pressure"] = 1e5
-            _check(p["dim"], p["friction"], p["velocity"], p["incline"], p["pressure"],
-                   p["gravity"], p["elements"], p["t_end"], 210e9, 0.3, 7850.0, 0.01,
-                   0.02)  # fmt: skip
-        elif demo == "two-bars":
-            from ..cli_demos import _two_bars
-            from .two_bars import run_two_bars
-
-            args = _subparser(demo).parse_args(_argv(demo, params, _subparser(demo))[1:])
-            _two_bars(args, lambda **kw: run_two_bars(**kw, check_only=True), None)
-        elif demo in ("taylor-bar", "wave"):
-            # the demo's own checks on the case's parsed command line, nothing run
-            args = _subparser(demo).parse_args(_argv(demo, params, _subparser(demo))[1:])
-            if demo == "taylor-bar":
-                from ..cli_taylor import run_options
-                from .taylor_bar import run_taylor_bar
-
-                run_taylor_bar(**run_options(args), check_only=True)
-            else:
-                from ..cli_demos import wave_options
-                from .wave import run_wave
-
-                run_wave(**wave_options(args), check_only=True)
-    except StudyError:
-        raise
+        check_case(demo, args)
     except ValueError as exc:
         raise StudyError(f"{demo}: {exc} (parameters {dict(params)})") from exc
 
