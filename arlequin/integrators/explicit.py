@@ -337,9 +337,10 @@ class CentralDifference(Integrator):
         return p_ext, pc, po
 
     def _forces(
-        self, u: np.ndarray, t: float, dt: float | None = None
+        self, u: np.ndarray, t: float, dt: float | None = None, blocks=None
     ) -> tuple[np.ndarray, np.ndarray | None, dict]:
-        f_int, trial, _ = self.ops.internal_force(u, self.states, dt=dt)
+        # blocks: the block indices whose internal force is evaluated (None: all)
+        f_int, trial, _ = self.ops.internal_force(u, self.states, dt=dt, blocks=blocks)
         f_ext = self.system.external_force(t) if self.system.load is not None else None
         if f_ext is not None and not f_ext.any():
             f_ext = None  # unloaded at t: skip the force and its power

@@ -315,11 +315,7 @@ class SubcycledCentralDifference(CentralDifference):
             self._f_slow = np.where(self._slow, f_int, 0.0)
             self._minv_f_slow = self.ops.inv_mass * self._f_slow
             return f_int, f_ext, trial
-        f_int, trial, _ = self.ops.internal_force(u, self.states, dt=dt, blocks=self._fast_b)
-        f_ext = self.system.external_force(t) if self.system.load is not None else None
-        if f_ext is not None and not f_ext.any():
-            f_ext = None
-        return f_int, f_ext, trial
+        return super()._forces(u, t, dt, blocks=self._fast_b)
 
     def _kick(self, v_minus: np.ndarray, dt_bar: float) -> np.ndarray:
         v_star = v_minus + dt_bar * self.a
