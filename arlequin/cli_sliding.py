@@ -15,9 +15,12 @@ def sliding_options(args: argparse.Namespace) -> dict:
     velocity = args.velocity
     if velocity is None:
         velocity = 0.0 if args.gravity is not None else 1.0
-    return dict(dim=args.dim, friction=args.friction, velocity=velocity, incline=args.incline,
+    opts = dict(dim=args.dim, friction=args.friction, velocity=velocity, incline=args.incline,
                 pressure=args.pressure, gravity=args.gravity, elements=args.elements,
-                t_end=args.t_end)  # fmt: skip
+                t_end=args.t_end, ramp_time=args.ramp_time)  # fmt: skip
+    if args.damping is not None:
+        opts["damping"] = args.damping
+    return opts
 
 
 def _cmd(args: argparse.Namespace) -> int:
@@ -53,12 +56,18 @@ def add_sliding_block(sub) -> None:
     load.add_argument("--pressure", type=float, default=None, metavar="P",
                       help="top pressure (Pa); the default loading, 1e5 Pa")
     load.add_argument("--gravity", type=float, default=None, metavar="G",
-                      help="gravity (m/s^2), ramped over 20 H/c_d from rest")
+                      help="gravity (m/s^2), ramped from rest over --ramp-time")
     p.add_argument("--elements", type=int, default=4, metavar="N",
                    help="elements across the height (twice as many along the width)")
     p.add_argument("--t-end", type=float, default=None, metavar="T",
                    help="simulated time after the launch or the ramp (s); default 1.3 x the "
                    "exact stop time, or 200 H/c_d")
+    p.add_argument("--damping", type=float, default=None, metavar="ZETA",
+                   help="damping ratio at the block's first shear mode (stiffness-proportional "
+                   "Rayleigh damping; 0: undamped, the edges then micro-slip after the stop); "
+                   "default the demo's DAMPING, 0.005")
+    p.add_argument("--ramp-time", type=float, default=None, metavar="T",
+                   help="duration of the gravity ramp (s); default 300 H/c_d")
     p.add_argument("--json", metavar="PATH", default=None, help="write the results as JSON")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     add_out(p)

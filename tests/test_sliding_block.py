@@ -47,8 +47,9 @@ def block_3d():
 
 def test_plane_strain_block_decelerates_at_the_exact_rate_and_stops(plane_strain):
     r, _ = plane_strain
-    # measured: rate −4e-6, stop +0.63% (the moving mean over one shear period falls below
-    # 1e-3 v0), energy balance 2.0e-4, 1.82 fixed-point iterations per step (max 2)
+    # measured (the demo's 0.5% damping): rate −7.6e-6, stop +4e-5 (the moving mean over one
+    # shear period falls below 1e-3 v0), energy balance 1.5e-4, 1.76 fixed-point iterations per
+    # step (max 2). Undamped: rate −4e-6, stop +0.63%.
     assert r.expected_acceleration == pytest.approx(-MU * 1e5 / (7850.0 * 0.01), rel=1e-12)
     assert r.acceleration == pytest.approx(r.expected_acceleration, rel=0.01)
     assert r.stop_time == pytest.approx(r.expected_stop_time, rel=0.01)
@@ -61,32 +62,28 @@ def test_plane_strain_block_decelerates_at_the_exact_rate_and_stops(plane_strain
 
 def test_3d_block_decelerates_at_the_exact_rate_and_stops(block_3d):
     r = block_3d
-    # measured: rate −8.7e-4, energy balance 1.4e-4, 2.0 iterations per step; the stop is
-    # within 5% (+3.0%), the 1% of the next test is not met
+    # measured (0.5% damping): rate −1.4e-5, stop +0.23%, energy balance 1.3e-4, 1.80
+    # iterations per step (max 2). Undamped the stop was +3.0% late: the base stuck and slipped
+    # by turns under the launch's shear vibrations
     assert r.acceleration == pytest.approx(r.expected_acceleration, rel=0.01)
-    assert r.stop_time == pytest.approx(r.expected_stop_time, rel=0.05)
+    assert r.stop_time == pytest.approx(r.expected_stop_time, rel=0.01)
     assert r.energy_balance_error < 0.01
     assert r.fixed_point_iterations["mean"] <= 10
 
 
-@pytest.mark.xfail(strict=True, reason="measured: +3.0%: the last 3% of the velocity decays "
-                   "slowly as the base sticks and slips by turns (4 cells across)")
-def test_3d_block_stops_within_one_percent(block_3d):
-    assert block_3d.stop_time == pytest.approx(block_3d.expected_stop_time, rel=0.01)
-
-
-@pytest.mark.xfail(strict=True, reason="measured: slip events of up to 9.7e-4 v0 go on after "
-                   "the stop (corner nodes, as the launch's vibrations decay)")
-def test_contact_nodes_stick_after_the_stop(plane_strain):
-    r, _ = plane_strain
+@pytest.mark.parametrize("which", ["plane_strain", "block_3d"])
+def test_contact_nodes_stick_after_the_stop_and_friction_never_creates_energy(which, request):
+    r = request.getfixturevalue(which)
+    r = r[0] if isinstance(r, tuple) else r
+    # measured: 2.2e-19 m/s after 1.1 × the stop time (round-off), no slipping step, no step
+    # with a positive friction work. Undamped (damping=0) the edges of the base micro-slip for
+    # ever, up to 9.7e-4 v0 over 38% of the steps, with 84 positive friction-work steps of
+    # 13,800: the elastic block's shear vibrations load the edges to the Coulomb limit (the
+    # demo's docstring)
     assert r.max_slip_after_stop <= 1e-6 * 1.0
-
-
-@pytest.mark.xfail(strict=True, reason="measured: 84 of 13800 steps have a positive friction "
-                   "work increment (the trapezoidal attribution across a velocity reversal)")
-def test_friction_dissipation_is_never_negative(plane_strain):
-    r, _ = plane_strain
+    assert r.slipping_steps_after_stop == 0.0
     assert r.negative_dissipation_steps == 0
+    assert r.damping_work[-1] < 0.0 and abs(r.damping_work[-1]) < 0.01 * abs(r.friction_work[-1])
 
 
 def test_results_folder_and_interface_keys(plane_strain):
@@ -106,12 +103,18 @@ def test_incline_transition_within_half_a_degree(offset, slides):
     theta = math.degrees(math.atan(MU)) + offset
     r = run_sliding_block(friction=MU, velocity=0.0, gravity=1e5, incline=theta, t_end=1e-3)
     width = 0.02
+    th = math.radians(theta)
     if slides:
         assert r.sliding_distance > 1e-3 * width
+        # measured +0.53% with the default quasi-static ramp (300 H/c_d); +15% with a ramp of
+        # 20 H/c_d, whose shear vibrations make the base stick by turns (the demo's RAMP_TRANSITS)
+        assert r.acceleration == pytest.approx(1e5 * (math.sin(th) - MU * math.cos(th)),
+                                               rel=0.01)  # fmt: skip
     else:
-        # measured 1.1e-9 m: no creep
+        # measured 3.8e-13 m: no creep (−0.1°: 2.6e-12 m; +0.1° slides, 0.5 mm in 1 ms)
         assert abs(r.sliding_distance) <= 1e-6 * width
-        assert r.energy_balance_error < 0.01
+    assert r.energy_balance_error < 0.01
+    assert r.negative_dissipation_steps == 0
 
 
 def test_incline_sliding_acceleration():
@@ -119,7 +122,7 @@ def test_incline_sliding_acceleration():
     r = run_sliding_block(friction=MU, velocity=0.0, gravity=1e5, incline=theta, t_end=1e-3)
     th = math.radians(theta)
     assert r.expected_acceleration == pytest.approx(1e5 * (math.sin(th) - MU * math.cos(th)))
-    # measured 2e-6 over 2 ms
+    # measured −4e-5 over 1 ms
     assert r.acceleration == pytest.approx(r.expected_acceleration, rel=0.01)
     assert r.energy_balance_error < 0.01
 

@@ -220,7 +220,10 @@ def plot_sliding_block(result: SlidingBlockResult, path: str) -> None:
     ax2.plot(t, e, label="kinetic + strain − W_ext")
     ax2.plot(t, fw, label="friction dissipation D_f")
     ax2.plot(t, cw, label="normal contact loss W_c")
-    ax2.plot(t, e + fw + cw, "k", lw=1.0, label="sum (constant)")
+    dd = -np.asarray(result.damping_work) if result.damping_work else np.zeros_like(e)
+    if dd.any():
+        ax2.plot(t, dd, label="damping dissipation D_d")
+    ax2.plot(t, e + fw + cw + dd, "k", lw=1.0, label="sum (constant)")
     ax2.set_xlabel("t (µs)")
     ax2.set_ylabel("J")
     ax2.legend(fontsize=8)

@@ -19,16 +19,17 @@ are :class:`arlequin.system.LinearConstraint`; unilateral rows (contact) follow
 :class:`arlequin.contract.UnilateralConstraint` (:class:`LinearInequality` is the minimal one).
 
 One concept a module: ``operators`` (mass, forces, tangents), ``rows`` (constraint rows),
-``linalg`` (factorisations), ``impulses`` (the explicit impulse solve), ``controllers`` (step
-sizes), ``base`` (the :class:`Integrator` class), ``registry``, ``explicit``, ``subcycling``,
-``implicit``, ``stability``, ``recorder``, ``result``, ``driver`` (:func:`solve`), ``static``,
-``loads``.
+``linalg`` (factorisations), ``impulses`` (the explicit impulse solve), ``damping`` (Rayleigh
+damping), ``controllers`` (step sizes), ``base`` (the :class:`Integrator` class), ``registry``,
+``explicit``, ``subcycling``, ``implicit``, ``stability``, ``recorder``, ``result``, ``driver``
+(:func:`solve`), ``static``, ``loads``.
 """
 
 from ..contract import ConstraintError, SimulationError, UnilateralConstraint
 from .base import Integrator, IntegratorSnapshot
 from .constraints import LinearInequality, is_unilateral
 from .controllers import CriticalFraction, FixedStep, StepController, StepSchedule
+from .damping import RayleighDamping
 from .driver import solve
 from .explicit import CentralDifference
 from .implicit import HHTAlpha, ImplicitIntegrator, Newmark, ThetaScheme
@@ -58,6 +59,7 @@ __all__ = [
     "LoadCurve",
     "Newmark",
     "Ramp",
+    "RayleighDamping",
     "Recorder",
     "SimulationError",
     "Sine",

@@ -187,6 +187,7 @@ class Integrator:
         self._w_coupling = np.zeros(nb)
         self._w_constraint = np.zeros(nb)
         self._w_internal = np.zeros(nb)
+        self._w_damping = np.zeros(nb)
         self.multipliers: dict[str, np.ndarray] = {}
         controller = as_controller(step_controller)
         if controller is None:
@@ -352,7 +353,7 @@ class Integrator:
     _SNAPSHOT_FIELDS: tuple[str, ...] = (
         "t", "_t_err", "dt", "step_size", "status", "u", "v", "a", "states", "constraint_states",
         "multipliers", "status_iterations", "n_status_failures", "_w_ext", "_w_coupling",
-        "_w_constraint", "_w_internal",
+        "_w_constraint", "_w_internal", "_w_damping",
     )  # fmt: skip
 
     def _scheme_fields(self) -> tuple[str, ...]:
@@ -461,9 +462,9 @@ class Integrator:
         -------
         dict
             ``{"kinetic", "kinetic_full_step", "strain", "external_work", "coupling_work",
-            "constraint_work"}``, each a dict block name -> float. ``kinetic`` is the scheme's
-            energy form (central differences: ½ ṽ^{n−½}·M v^{n+½}, whose balance closes to
-            round-off for linear systems), ``kinetic_full_step`` ½ vᵀM v of the velocity at t.
+            "constraint_work", "damping_work"}``, block name -> float. ``kinetic`` is the
+            scheme's energy form (central differences: ½ ṽ^{n−½}·M v^{n+½}, whose balance closes
+            to round-off for linear systems), ``kinetic_full_step`` ½ vᵀM v of v at t.
         """
         names = self.ops.names
         kin = self._kinetic()
@@ -479,6 +480,7 @@ class Integrator:
             "external_work": dict(zip(names, w_ext.tolist())),
             "coupling_work": dict(zip(names, w_coupling.tolist())),
             "constraint_work": dict(zip(names, w_constraint.tolist())),
+            "damping_work": dict(zip(names, self._damping_work().tolist())),
         }
 
     def _kinetic(self) -> np.ndarray:
@@ -488,6 +490,9 @@ class Integrator:
     def _works(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Accumulated external, coupling and other-constraint works per block up to t (J)."""
         return self._w_ext, self._w_coupling, self._w_constraint
+
+    def _damping_work(self) -> np.ndarray:  # (J) per block, ≤ 0; RayleighDamping's
+        return self._w_damping
 
     def total_energy(self) -> float:
         """Σ_b T_b + U_b (J)."""

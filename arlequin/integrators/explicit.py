@@ -46,6 +46,7 @@ import scipy.sparse as sp
 from ..contract import SimulationError, capabilities
 from .base import Integrator
 from .controllers import FixedStep, StepController
+from .damping import RayleighDamping
 from .impulses import ImpulseSolver
 from .registry import register
 from .rows import transposed, unilateral_block_power
@@ -72,6 +73,10 @@ class CentralDifference(Integrator):
         Estimate of the critical step (see :mod:`arlequin.integrators.stability`).
     check_dt : bool
         Refuse a step above the critical one (default True).
+    damping : RayleighDamping, optional
+        Rayleigh damping C = α M + β K₀ (:mod:`arlequin.integrators.damping`): the force
+        −C v^{n−1/2} at t_n, the critical step reduced accordingly, the dissipated energy in
+        ``energies()["damping_work"]``. Default none.
     **kwargs
         See :class:`arlequin.integrators.base.Integrator` (``step_controller`` among them: e.g.
         :class:`~arlequin.integrators.CriticalFraction` to follow a changing configuration).
@@ -96,8 +101,15 @@ class CentralDifference(Integrator):
         safety: float = DEFAULT_SAFETY,
         stable_method: str = "coupled",
         check_dt: bool = True,
+        damping: RayleighDamping | None = None,
         **kwargs: Any,
     ) -> None:
+        if damping is not None and not isinstance(damping, RayleighDamping):
+            raise TypeError(f"damping must be a RayleighDamping or None, got "
+                            f"{type(damping).__name__}")  # fmt: skip
+        self.damping = damping if damping is not None and damping.active else None
+        self._c_matrix: sp.csr_matrix | None = None
+        self._f_damp: np.ndarray | None = None
         if not 0.0 < safety <= 1.0:
             raise ValueError(f"safety factor must lie in (0, 1], got safety={safety}")
         if kwargs.get("lumped") is False:
@@ -129,6 +141,8 @@ class CentralDifference(Integrator):
             self.stable_step = stable_time_step(
                 self.system, self.stable_method, _ops=self.ops, _rows=self.rows, _s_lu=solver.lu
             )
+            if self.damping is not None:
+                self.stable_step = self.damping.stable_step(self.stable_step)
             self.critical_dt = self.stable_step.critical
         return self.stable_step
 
@@ -307,8 +321,7 @@ class CentralDifference(Integrator):
         # balance of the scheme's energy exactly for linear systems. Pending until the next
         # step starts, since a new step size at t changes the forces at t.
         half = 0.5 * dt_prev
-        (pe, pc, po), (qe, qc, qo) = self._p_prev, self._powers(v_minus)
-        self._w_pending = (half * (pe + qe), half * (pc + qc), half * (po + qo))
+        self._w_pending = tuple(half * (p + q) for p, q in zip(self._p_prev, self._powers(v_minus)))
 
     def _kick(self, v_minus: np.ndarray, dt_bar: float) -> np.ndarray:
         """The free prediction v* = v^{n−½} + Δt̄_n a^n (a new array)."""
@@ -320,9 +333,9 @@ class CentralDifference(Integrator):
         back = self._v_next - (self.dt / self._dt_bar) * (self._v_next - self._v_minus)
         return 0.5 * self.ops.block_dots(back, self.ops.mass * self._v_next)
 
-    def _powers(self, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """External, coupling and other-constraint powers per block (W) of the forces at the
-        current time with the velocity v (m/s)."""
+    def _powers(self, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """External, coupling, other-constraint and damping powers per block (W) of the forces
+        at the current time with the velocity v (m/s)."""
         nb = len(self.ops.blocks)
         p_ext = self.ops.block_dots(self._f_ext, v) if self._f_ext is not None else np.zeros(nb)
         if self.rows.m:
@@ -334,7 +347,17 @@ class CentralDifference(Integrator):
             po = po + unilateral_block_power(self.ops, self._g_a, self._lam_a / self._dt_bar, v)
         if self._f_applied is not None:  # slip friction
             po = po + self.ops.block_dots(self._f_applied, v)
-        return p_ext, pc, po
+        if self._f_damp is None:
+            return p_ext, pc, po, np.zeros(nb)
+        return p_ext, pc, po, -self.ops.block_dots(self._f_damp, v)
+
+    def _damping_force(self, v: np.ndarray) -> np.ndarray | None:
+        """C v (N) with the mid-step velocity v that precedes the force's time, or None."""
+        if self.damping is None:
+            return None
+        if self._c_matrix is None:
+            self._c_matrix = self.damping.matrix(self.ops.mass, self.ops.initial_stiffness())
+        return self._c_matrix @ v
 
     def _forces(
         self, u: np.ndarray, t: float, dt: float | None = None, blocks=None
@@ -356,12 +379,14 @@ class CentralDifference(Integrator):
         self.states = trial
         self._f_int = f_int
         self._f_ext = f_ext
-        self.a = self._acceleration(f_int, f_ext)
-        self._dt_prev = 0.0
         self._v_minus = self.v.copy()  # v^{-1/2} = v^0: the first kick is a half step
+        self._f_damp = self._damping_force(self._v_minus)
+        f_all = f_int if self._f_damp is None else f_int + self._f_damp
+        self.a = self._acceleration(f_all, f_ext)
+        self._dt_prev = 0.0
         self._pre_impulse_states = self.constraint_states
         nb = len(self.ops.blocks)
-        self._p_prev = (np.zeros(nb), np.zeros(nb), np.zeros(nb))
+        self._p_prev = (np.zeros(nb), np.zeros(nb), np.zeros(nb), np.zeros(nb))
         self._impulse_at_t()
 
     def _step_size_changed(self) -> None:
@@ -372,14 +397,17 @@ class CentralDifference(Integrator):
         self._impulse_at_t()
 
     def _works(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        pe, pc, po = self._w_pending
+        pe, pc, po, _ = self._w_pending
         return self._w_ext + pe, self._w_coupling + pc, self._w_constraint + po
+
+    def _damping_work(self) -> np.ndarray:
+        return self._w_damping + self._w_pending[3]
 
     def _scheme_fields(self) -> tuple[str, ...]:
         return (
             "_v_next", "_v_minus", "_dt_prev", "_dt_bar", "_f_int", "_f_ext", "_lam_e", "_lam_a",
             "_g_a", "_p_prev", "_w_pending", "_pre_impulse_states", "_critical_now",
-            "_critical_at", "_impulse_failed", "_f_applied",
+            "_critical_at", "_impulse_failed", "_f_applied", "_f_damp",
         )  # fmt: skip
 
     # ------------------------------------------------------------------ step
@@ -389,9 +417,11 @@ class CentralDifference(Integrator):
         v_half = self._v_next
         u_new = self.u + dt * v_half
         f_int, f_ext, trial = self._forces(u_new, t_new, dt)
-        a_new = self._acceleration(f_int, f_ext)
+        f_damp = self._damping_force(v_half)  # −C v^{n+1/2}: the damping force at t_{n+1}
+        a_new = self._acceleration(f_int if f_damp is None else f_int + f_damp, f_ext)
         # the step size at t is final now: commit the works of the step that ended at t
         self._w_ext, self._w_coupling, self._w_constraint = self._works()
+        self._w_damping = self._damping_work()
         self._p_prev = self._powers(v_half)  # the forces at t with this step's velocity
         # commit the step's kinematics and model states
         if not self.ops.linear:
@@ -402,6 +432,7 @@ class CentralDifference(Integrator):
         self.t = t_new
         self._f_int = f_int
         self._f_ext = f_ext
+        self._f_damp = f_damp
         self._dt_prev = dt
         self._v_minus = v_half
         self.step_size = dt

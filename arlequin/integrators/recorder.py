@@ -103,6 +103,7 @@ class Recorder:
             external_work=hist("external_work"),
             coupling_work=hist("coupling_work"),
             constraint_work=hist("constraint_work"),
+            damping_work=hist("damping_work"),
             multipliers={k: np.array(v) for k, v in self.mult.items()},
             status_iterations=np.array(self.iters, dtype=np.int64),
             u=it.u.copy(),

@@ -75,6 +75,9 @@ class DynamicResult:
     kinetic_full_step : dict
         Block name -> ½ vᵀM v of the full-step velocity (J), shape (n_rec,): a diagnostic (for
         the explicit scheme it differs from ``kinetic`` by O((ωΔt)²) of the excited modes).
+    damping_work : dict
+        Block name -> work of the damping forces since the start (J, ≤ 0), shape (n_rec,):
+        zeros without :class:`~arlequin.integrators.RayleighDamping`.
     """
 
     times: np.ndarray
@@ -100,6 +103,7 @@ class DynamicResult:
     constraint_states: dict[str, Any] = field(default_factory=dict, repr=False)
     constraint_records: dict[str, list[Any]] = field(default_factory=dict, repr=False)
     kinetic_full_step: dict[str, np.ndarray] = field(default_factory=dict)
+    damping_work: dict[str, np.ndarray] = field(default_factory=dict)
 
     @property
     def success(self) -> bool:
@@ -137,8 +141,12 @@ class DynamicResult:
         return self._sum(self.constraint_work, self.times.size)
 
     @property
+    def total_damping_work(self) -> np.ndarray:
+        return self._sum(self.damping_work, self.times.size)
+
+    @property
     def balance(self) -> np.ndarray:
-        """E − E(0) − W_ext − W_c − W_r (J): the numerical energy error, shape (n_rec,)."""
+        """E − E(0) − W_ext − W_c − W_r − W_d (J): the numerical energy error, shape (n_rec,)."""
         e = self.total_energy
         return (
             e
@@ -146,6 +154,7 @@ class DynamicResult:
             - self.total_external_work
             - self.total_coupling_work
             - self.total_constraint_work
+            - self.total_damping_work
         )
 
     def block_balance(self, block: str) -> np.ndarray:
@@ -157,6 +166,7 @@ class DynamicResult:
             - self.external_work[block]
             - self.coupling_work[block]
             - self.constraint_work[block]
+            - self.damping_work.get(block, 0.0)
         )
 
     def energy_drift(self) -> float:

@@ -116,6 +116,10 @@ class SubcycledCentralDifference(CentralDifference):
         check_dt: bool = True,
         **kwargs: Any,
     ) -> None:
+        if kwargs.get("damping") is not None:
+            raise ValueError("damping is not supported by the multi-time-step integrator "
+                             "(its slow blocks' damping force would be applied per macro step): "
+                             "use the explicit integrator")  # fmt: skip
         if isinstance(step_ratio, bool) or int(step_ratio) != step_ratio or step_ratio < 1:
             raise ValueError(
                 f"step_ratio must be a positive integer, got step_ratio={step_ratio!r}"

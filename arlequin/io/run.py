@@ -18,7 +18,8 @@ from .layout import FieldLayout
 __all__ = ["DynamicRunWriter", "write_static"]
 
 _ENERGIES = ("kinetic", "strain", "external_work", "coupling_work", "constraint_work",
-             "kinetic_full_step")  # fmt: skip
+             "kinetic_full_step", "damping_work")  # fmt: skip
+_WORKS = ("external_work", "coupling_work", "constraint_work", "damping_work")
 
 
 class DynamicRunWriter:
@@ -68,7 +69,7 @@ class DynamicRunWriter:
         e = integ.energies()
         row = {"t": integ.t, "dt": integ.step_size or 0.0, "step": integ.step_count}
         total = sum(e["kinetic"].values()) + sum(e["strain"].values())
-        works = sum(sum(e[k].values()) for k in _ENERGIES[2:5])
+        works = sum(sum(e[k].values()) for k in _WORKS)
         if self._e0 is None:
             self._e0 = total
         row["energy"] = total
