@@ -9,6 +9,8 @@ Public API (``docs/api.md`` lists every name with the module it lives in)
 ArlequinProblem, Patch,
 PatchCoupling                   set up a coupled problem (:mod:`arlequin.problem`,
                                 :mod:`arlequin.gluing`)
+MultiBodyProblem                several bodies (problems or models) in one system
+                                (:mod:`arlequin.bodies`)
 refine_region                   nested patches from coarse cells (:mod:`arlequin.patches`)
 RampWeights, ConstantWeights,
 CallableWeights                 partition weights (:mod:`arlequin.weights`)
@@ -49,6 +51,7 @@ def _map_models_folder() -> None:
 
 _map_models_folder()
 
+from .bodies import MultiBodyProblem
 from .contract import (
     CapabilityError,
     ConstraintError,
@@ -84,6 +87,7 @@ __all__ = [
     "ExactnessWarning",
     "MediatorError",
     "MeshError",
+    "MultiBodyProblem",
     "Overlap",
     "OverlapError",
     "Patch",

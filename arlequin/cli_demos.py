@@ -1,4 +1,5 @@
-"""The demos' subcommands (patch-test, two-bars, wave, taylor-bar, sliding-block): their
+"""The demos' subcommands (patch-test, two-bars, wave, taylor-bar, sliding-block,
+ball-impact): their
 options and their runs, shared by ``arlequin`` and the study runner (:mod:`arlequin.demos.study`),
 which parses and runs a case exactly as the command line would."""
 
@@ -6,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 
+from .cli_ball import add_ball_impact
 from .cli_common import add_out as _add_out
 from .cli_common import progress_bar
 from .cli_common import write_json as _write_json
@@ -22,6 +24,7 @@ def add_demos(sub) -> None:
     _add_wave(sub)
     add_taylor_bar(sub)
     add_sliding_block(sub)
+    add_ball_impact(sub)
 
 
 def check_case(demo: str, args: argparse.Namespace) -> None:
@@ -46,6 +49,11 @@ def check_case(demo: str, args: argparse.Namespace) -> None:
         from .demos.sliding_block import run_sliding_block
 
         run_sliding_block(**sliding_options(args), check_only=True)
+    elif demo == "ball-impact":
+        from .cli_ball import ball_options
+        from .demos.ball_impact import run_ball_impact
+
+        run_ball_impact(**ball_options(args), check_only=True)
 
 
 def demo_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.ArgumentParser]]:

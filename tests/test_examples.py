@@ -53,9 +53,25 @@ def test_two_bars_example_runs_small(tmp_path):
 
 
 # every example is run by the suite: the guard fails when a new one is not
-COVERED = {"refined_patch", "arlequin_taylor_bar", "two_bars", "plate_with_hole"}
+COVERED = {"refined_patch", "arlequin_taylor_bar", "two_bars", "plate_with_hole", "ball_on_block"}
 
 
 def test_every_example_is_covered():
     names = {p.stem for p in EXAMPLES.glob("*.py")}
     assert names == COVERED, f"examples not run by the test suite: {sorted(names - COVERED)}"
+
+
+def test_ball_on_block_tutorial_is_the_demo():
+    # the tutorial builds with the public API what run_ball_impact builds at the same sizes:
+    # the same steps and the same answer (to round-off)
+    import math
+
+    from arlequin.demos.ball_impact import run_ball_impact
+
+    out = load("ball_on_block").run(n=20, levels=1)
+    h_c = 0.25 * math.pi * 0.01 / 20
+    demo = run_ball_impact(coarse_size=h_c, fine_size=h_c / 2)
+    assert out["n_steps"] == demo.n_steps
+    assert out["peak_force"] == pytest.approx(demo.peak_force, rel=1e-12)
+    assert out["contact_duration"] == demo.contact_duration
+    assert out["hertz_peak_force"] == pytest.approx(demo.hertz["hertz_peak_force"], rel=1e-12)

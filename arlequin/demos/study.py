@@ -106,7 +106,7 @@ def run_case(demo: str, params: Mapping[str, Any], out: str | os.PathLike,
     parser, commands = demo_parser()
     argv = _argv(demo, params, commands[demo])
     argv += ["--json", str(out / "case.json"), "--out", str(out / "run")]
-    if demo in ("taylor-bar", "sliding-block", "two-bars", "wave"):
+    if demo in ("taylor-bar", "sliding-block", "two-bars", "wave", "ball-impact"):
         argv.append("--quiet")
     args = parser.parse_args(argv)
     # the command's own run: an error of the demo is the case's error (its message recorded);

@@ -182,8 +182,6 @@ def load_spec(spec: str | os.PathLike | Mapping[str, Any]) -> StudySpec:
         _resolve(demo)  # importable
     elif demo not in DEMOS:
         raise StudyError(f"demo {demo!r} is not one of {list(DEMOS)} (or \"module:function\")")
-    elif demo == "ball-impact":
-        raise StudyError("demo 'ball-impact' is not available yet in this version")
     else:
         parser = _subparser(demo)
         for case in cases:

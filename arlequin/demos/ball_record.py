@@ -1,0 +1,188 @@
+"""What the ball-impact demo records at each step, and the files and pictures it writes.
+
+:class:`ImpactRecorder` is an ``on_step`` listener: per step the contact force, the ball's mean
+velocity, the energies (kinetic, elastic, plastic dissipation, contact and coupling works) and
+the integrator's energy balance, written to ``impact.csv`` as the run goes when a results
+folder is open. SI units.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .ball_result import HISTORY_KEYS, HISTORY_UNITS, RESULT_UNITS, BallImpactResult
+
+__all__ = ["ImpactRecorder", "hertz_force_history", "write_outputs"]
+
+
+class ImpactRecorder:
+    """The per-step records of a ball-impact run (module docstring).
+
+    Parameters
+    ----------
+    bodies : ImpactBodies
+    folder : ResultsFolder or None
+    t_end : float
+        Simulated time (s), for the progress fraction.
+    progress : callable, optional
+        ``progress(fraction)`` at each new percent.
+    """
+
+    def __init__(self, bodies, folder, t_end: float, progress=None) -> None:
+        self.bodies = bodies
+        self.t_end = float(t_end)
+        self.progress = progress
+        self.rows: dict[str, list[float]] = {k: [] for k in HISTORY_KEYS}
+        self.balance: list[float] = []
+        self.scale = 0.0
+        self.contact_radius = 0.0
+        self._pct = -1
+        self.csv = folder.history(list(HISTORY_KEYS), HISTORY_UNITS, name="impact") if folder \
+            else None  # fmt: skip
+        j2, name = bodies.plastic_model()
+        self._j2, self._j2_block = j2, name
+        if j2 is not None:
+            self._j2_weight = bodies.system.block(name).terms[0].weight
+        self._e0: float | None = None
+
+    def __call__(self, integ) -> None:
+        b = self.bodies
+        e = integ.energies()
+        kinetic = sum(e["kinetic"].values())
+        strain = sum(e["strain"].values())  # nonlinear blocks: the internal work
+        works = sum(sum(e[k].values()) for k in ("external_work", "coupling_work",
+                                                   "constraint_work", "damping_work"))  # fmt: skip
+        elastic, plastic = strain, 0.0
+        if self._j2 is not None:
+            state = integ.states[self._j2_block][0]
+            u_j2 = integ.u[integ.system.dofmap[self._j2_block].slice]
+            plastic = self._j2.plastic_dissipation(state, self._j2_weight)
+            stored = self._j2.stored_energy(u_j2, state, self._j2_weight)
+            elastic = strain - e["strain"][self._j2_block] + stored
+        total = kinetic + strain - works
+        if self._e0 is None:
+            self._e0 = total
+        self.scale = max(self.scale, abs(kinetic + strain))
+        self.balance.append(total - self._e0)
+        st = integ.constraint_states.get("contact")
+        active = getattr(st, "active", None)
+        if active is not None and np.any(active):
+            self.contact_radius = max(self.contact_radius, float(b.slave_r[active].max()))
+        row = {"t": integ.t, "contact_force": b.contact_force(integ.multipliers),
+               "ball_velocity": b.ball_velocity(integ.v), "kinetic": kinetic,
+               "elastic": elastic, "plastic_dissipation": plastic,
+               "contact_work": float(getattr(st, "work", 0.0)),
+               "coupling_work": float(sum(e["coupling_work"].values()))}  # fmt: skip
+        for k in HISTORY_KEYS:
+            self.rows[k].append(float(row[k]))
+        if self.csv is not None:
+            self.csv.append(row)
+        if self.progress is not None:
+            pct = int(100 * integ.t / self.t_end)
+            if pct != self._pct:
+                self._pct = pct
+                self.progress(min(integ.t / self.t_end, 1.0))
+
+    def result(self, res, wall: float, patch_fraction: float, hertz: dict,
+               config: dict) -> BallImpactResult:  # fmt: skip
+        """The run's :class:`BallImpactResult` from its records and its final state ``res``."""
+        b = self.bodies
+        t = np.asarray(self.rows["t"])
+        force = np.asarray(self.rows["contact_force"])
+        touching = np.nonzero(force > 0.0)[0]
+        duration = float(t[touching[-1]]) if touching.size else 0.0
+        if touching.size and touching[-1] == t.size - 1:
+            raise ValueError(f"the ball is still in contact at the end of the run "
+                             f"(t_end={t[-1]:.4g} s): give a longer t_end")  # fmt: skip
+        max_eqps = band_eqps = 0.0
+        if self._j2 is not None:
+            eqps = res.states[self._j2_block][0].eqps
+            max_eqps = float(np.max(eqps))
+            if b.band_cells.size:
+                band_eqps = float(np.max(eqps[b.band_cells]))
+        v0 = -self.rows["ball_velocity"][0] if t.size else 0.0
+        scale = max(self.scale, 1e-300)
+        return BallImpactResult(
+            contact_duration=duration, peak_force=float(force.max()) if force.size else 0.0,
+            restitution=float(self.rows["ball_velocity"][-1] / v0) if v0 else 0.0,
+            dent_depth=b.dent_depth(res.u), max_plastic_strain=max_eqps,
+            energy_balance_error=float(np.max(np.abs(self.balance)) / scale),
+            patch_fraction=float(patch_fraction), n_elements=b.n_elements, wall_time_s=wall,
+            history={k: list(v) for k, v in self.rows.items()}, hertz=dict(hertz),
+            n_steps=int(res.n_steps), fine_size=b.sizes.fine, coarse_size=b.sizes.coarse,
+            contact_radius_cells=self.contact_radius / b.sizes.fine,
+            band_max_plastic_strain=band_eqps, config=dict(config),
+        )  # fmt: skip
+
+
+def hertz_force_history(mass: float, velocity: float, peak: float, duration: float,
+                        n: int = 400) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """Hertz's force against time (s, N): m δ'' = −F, F = k δ^{3/2}, k from the peak force."""
+    from scipy.integrate import solve_ivp
+
+    # k from the peak and the energy: F_max = k δ^{3/2}, ½ m v² = 2/5 k δ^{5/2}
+    d_max = 2.5 * 0.5 * mass * velocity**2 / peak
+    k = peak / d_max**1.5
+    sol = solve_ivp(lambda _t, y: [y[1], -k * max(y[0], 0.0) ** 1.5 / mass], (0.0, duration),
+                    [0.0, velocity], t_eval=np.linspace(0.0, duration, n), rtol=1e-10,
+                    atol=1e-14)  # fmt: skip
+    return sol.t, k * np.maximum(sol.y[0], 0.0) ** 1.5
+
+
+def _picture(result: BallImpactResult, bodies, res, path: str) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.collections import PolyCollection
+
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.8))
+    t = np.asarray(result.history["t"]) * 1e6
+    ax1.plot(t, np.asarray(result.history["contact_force"]) * 1e-3, lw=1.2,
+             label=f"{result.config.get('model')}")  # fmt: skip
+    if result.hertz:
+        th, fh = hertz_force_history(bodies.ball_mass, result.config["velocity"],
+                                     result.hertz["hertz_peak_force"],
+                                     result.hertz["hertz_contact_duration"])  # fmt: skip
+        ax1.plot(th * 1e6, fh * 1e-3, "k--", lw=1.0, label="Hertz")
+    ax1.set_xlabel("t (µs)")
+    ax1.set_ylabel("contact force (kN)")
+    ax1.legend()
+    ax1.set_title(f"ball impact, {result.config.get('regime')} regime, "
+                  f"v0 = {result.config.get('velocity')} m/s")  # fmt: skip
+    dm = bodies.system.dofmap
+    j2, j2_block = bodies.plastic_model()
+    eqps = res.states[j2_block][0].eqps.mean(axis=1) if j2 is not None else None
+    for name, mesh in bodies.meshes.items():
+        u = res.u[dm[name].slice]
+        x = mesh.p + np.stack([u[0::2], u[1::2]])
+        polys = np.moveaxis(x[:, mesh.t], 0, -1)  # (4, n_cells, 2) -> cells of 4 points
+        polys = np.transpose(polys, (1, 0, 2))
+        patch = name.endswith(".patch") or bodies.model == "mono"
+        if name == j2_block and eqps is not None:
+            pc = PolyCollection(polys, array=eqps, cmap="viridis", edgecolors="none")
+            fig.colorbar(pc, ax=ax2, label="equivalent plastic strain")
+        else:
+            pc = PolyCollection(polys, facecolors="#c8d7e8" if patch else "none",
+                                edgecolors="#a9bccf" if patch else "#7a8da3",
+                                linewidths=0.15 if patch else 0.4)  # fmt: skip
+        ax2.add_collection(pc)
+    reach = 2.0 * bodies.sizes.reach
+    ax2.set_xlim(0.0, reach)
+    ax2.set_ylim(-reach, reach)
+    ax2.set_aspect("equal")
+    ax2.set_title("final state: coarse cells outlined, patches filled")
+    ax2.set_xlabel("r (m)")
+    ax2.set_ylabel("z (m)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def write_outputs(folder, result: BallImpactResult, bodies, res) -> None:
+    """The results with units and the picture, then close the folder."""
+    data = result.to_json()
+    keys = [k for k in RESULT_UNITS if k in data]
+    folder.add_results({k: data[k] for k in keys}, RESULT_UNITS)
+    _picture(result, bodies, res, str(folder.picture("ball_impact")))
+    folder.finish()

@@ -1,0 +1,132 @@
+"""The result of a ball-impact run, its keys and units, and Hertz's impact solution.
+
+SI units; see :mod:`arlequin.demos.ball_impact`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+from ..io import JsonResult
+from ..models import IsotropicElastic
+
+__all__ = ["HISTORY_KEYS", "HISTORY_UNITS", "INPUT_UNITS", "JSON_KEYS", "RESULT_UNITS",
+           "BallImpactResult", "hertz"]
+
+#: The Interface's keys, in order (then the Hertz values and the inputs).
+JSON_KEYS = ("contact_duration", "peak_force", "restitution", "dent_depth",
+             "max_plastic_strain", "energy_balance_error", "patch_fraction", "n_elements",
+             "wall_time_s", "history")  # fmt: skip
+HISTORY_KEYS = ("t", "contact_force", "ball_velocity", "kinetic", "elastic",
+                "plastic_dissipation", "contact_work", "coupling_work")  # fmt: skip
+HISTORY_UNITS = {"t": "s", "contact_force": "N", "ball_velocity": "m/s", "kinetic": "J",
+                  "elastic": "J", "plastic_dissipation": "J", "contact_work": "J",
+                  "coupling_work": "J"}  # fmt: skip
+INPUT_UNITS = {"regime": "", "model": "", "velocity": "m/s", "ball_radius": "m",
+               "block_radius": "m", "block_height": "m", "patch_size": "m", "fine_size": "m",
+               "coarse_size": "m", "friction": "1", "rigid_wall": "", "coarse_step_ratio": "1",
+               "t_end": "s", "ball_material": "", "block_material": ""}  # fmt: skip
+RESULT_UNITS = {"contact_duration": "s", "peak_force": "N", "restitution": "1",
+                "dent_depth": "m", "max_plastic_strain": "1", "energy_balance_error": "1",
+                "patch_fraction": "1", "n_elements": "1", "wall_time_s": "s",
+                "hertz_peak_force": "N", "hertz_contact_duration": "s",
+                "hertz_indentation": "m", "hertz_contact_radius": "m", "fine_size": "m",
+                "coarse_size": "m", "n_steps": "1", "contact_radius_cells": "1",
+                "band_max_plastic_strain": "1"}  # fmt: skip
+
+def hertz(radius: float, mass: float, velocity: float, ball: IsotropicElastic,
+          block: IsotropicElastic | None) -> dict[str, float]:  # fmt: skip
+    """Hertz's impact of an elastic sphere (radius m, mass kg, velocity m/s) on an elastic
+    half-space of material ``block`` (None: rigid): peak force (N), contact duration (s),
+    maximum indentation (m), maximum contact radius (m) (module docstring)."""
+    inv = (1 - ball.poisson**2) / ball.young
+    if block is not None:
+        inv += (1 - block.poisson**2) / block.young
+    e_star = 1.0 / inv
+    delta = (15 * mass * velocity**2 / (16 * e_star * math.sqrt(radius))) ** 0.4
+    return {"hertz_peak_force": 4.0 / 3.0 * e_star * math.sqrt(radius) * delta**1.5,
+            "hertz_contact_duration": 2.9432 * delta / velocity, "hertz_indentation": delta,
+            "hertz_contact_radius": math.sqrt(radius * delta)}  # fmt: skip
+
+
+@dataclass
+class BallImpactResult(JsonResult):
+    """What a ball-impact run computed (SI units; see the module docstring).
+
+    Attributes
+    ----------
+    contact_duration, peak_force, restitution, dent_depth, max_plastic_strain : float
+        s, N, 1, m, 1.
+    energy_balance_error : float
+        The integrator's balance error over the run against the largest energy (1).
+    patch_fraction : float
+        p: the patches' elements over those of the uniformly fine (``mono``) meshes of both
+        bodies (1; the Arlequin model's, 1 for ``mono``).
+    n_elements : int
+        Elements of the run (every mesh).
+    wall_time_s : float
+        Wall time of the time loop (s).
+    history : dict
+        Per step (decimated to at most 2000 points in the JSON): ``t`` (s), ``contact_force``
+        (N), ``ball_velocity`` (m/s, along z), ``kinetic``, ``elastic`` (strain energy of the
+        elastic models and stored energy of the J2 one), ``plastic_dissipation``,
+        ``contact_work``, ``coupling_work`` (J).
+    hertz : dict
+        Hertz's values (elastic regime; empty otherwise).
+    contact_radius_cells : float
+        The largest contact radius in fine cells (1).
+    band_max_plastic_strain : float
+        The largest ε̄p in the block patch's gluing band (1; the coarse model glued there is
+        elastic: a warning above 0.02).
+    """
+
+    contact_duration: float
+    peak_force: float
+    restitution: float
+    dent_depth: float
+    max_plastic_strain: float
+    energy_balance_error: float
+    patch_fraction: float
+    n_elements: int
+    wall_time_s: float
+    history: dict[str, list[float]]
+    hertz: dict[str, float] = field(default_factory=dict)
+    n_steps: int = 0
+    fine_size: float = 0.0
+    coarse_size: float = 0.0
+    contact_radius_cells: float = 0.0
+    band_max_plastic_strain: float = 0.0
+    config: dict[str, Any] = field(default_factory=dict)
+
+    def to_json(self) -> dict[str, Any]:
+        """The Interface's keys first, then Hertz's values, then the inputs and the rest."""
+        data = super().to_json()
+        n = len(self.history.get("t", ()))
+        step = max(1, math.ceil(n / 2000))
+        data["history"] = {k: v[::step] for k, v in data["history"].items()}
+        ordered = {k: data.pop(k) for k in JSON_KEYS}
+        extra = data.pop("hertz")
+        config = data.pop("config")
+        return {**ordered, **extra, **config, **data}
+
+    def errors(self) -> dict[str, float]:
+        """Relative errors of the peak force and the contact duration against Hertz (1)."""
+        if not self.hertz:
+            return {}
+        return {"peak_force": self.peak_force / self.hertz["hertz_peak_force"] - 1.0,
+                "contact_duration": (self.contact_duration
+                                     / self.hertz["hertz_contact_duration"] - 1.0)}  # fmt: skip
+
+    def summary(self) -> str:
+        """One line: the measured quantities (and their errors against Hertz)."""
+        err = self.errors()
+        against = (f" (Hertz: {100 * err['peak_force']:+.2f}%, "
+                   f"{100 * err['contact_duration']:+.2f}%)" if err else "")  # fmt: skip
+        return (f"ball impact ({self.config.get('model')}, {self.config.get('regime')}): peak "
+                f"force {self.peak_force:.6g} N, contact {self.contact_duration:.6g} s{against}, "
+                f"restitution {self.restitution:.4f}, dent {self.dent_depth:.4g} m, max eqps "
+                f"{self.max_plastic_strain:.4g}, balance {self.energy_balance_error:.2e}, "
+                f"{self.n_elements} elements (p = {self.patch_fraction:.3f}), "
+                f"{self.wall_time_s:.1f} s")  # fmt: skip
