@@ -35,7 +35,8 @@ def ball_options(args: argparse.Namespace) -> dict:
     return dict(regime=args.regime, model=args.model, velocity=args.velocity,
                 ball_radius=args.ball_radius, block_radius=args.block_radius,
                 block_height=args.block_height, ball_material=ball, block_material=block,
-                patch_size=args.patch_size, fine_size=args.fine_size,
+                patch_size=args.patch_size, block_patch_size=args.block_patch_size,
+                fine_size=args.fine_size,
                 coarse_size=args.coarse_size, friction=args.friction,
                 rigid_wall=args.rigid_wall, coarse_step_ratio=args.coarse_step_ratio,
                 t_end=args.t_end)  # fmt: skip
@@ -67,7 +68,9 @@ def add_ball_impact(sub) -> None:
     p.add_argument("--regime", choices=["elastic", "plastic"], default="elastic")
     p.add_argument("--model", choices=["arlequin", "mono", "mono-zoned", "graded"],
                    default="arlequin", help="arlequin: coarse models plus patches; mono: one "
-                   "uniformly fine mesh per body (mono-zoned, graded: not built yet)")  # fmt: skip
+                   "uniformly fine mesh per body (J2 in the whole block); mono-zoned: the same, "
+                   "J2 in the patch region only; graded: conforming meshes graded from the "
+                   "contact")  # fmt: skip
     p.add_argument("--velocity", type=float, default=None, metavar="V",
                    help="impact velocity (m/s); default 1 (elastic) or 10 (plastic)")
     p.add_argument("--ball-radius", type=float, default=0.01, metavar="R", help="ball radius (m)")
@@ -90,6 +93,9 @@ def add_ball_impact(sub) -> None:
     p.add_argument("--patch-size", type=float, default=None, metavar="RP",
                    help="radius of the patches around the contact point (m); default 0.2 R "
                    "(elastic), 0.4 R (plastic)")  # fmt: skip
+    p.add_argument("--block-patch-size", type=float, default=None, metavar="RP",
+                   help="radius of the block's patch (m), if larger; default --patch-size "
+                   "(elastic), 0.8 R (plastic)")  # fmt: skip
     p.add_argument("--fine-size", type=float, default=None, metavar="H",
                    help="cell size of the patches (m); default 10 cells across Hertz's contact "
                    "radius (elastic), half the coarse size (plastic)")  # fmt: skip

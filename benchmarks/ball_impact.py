@@ -1,15 +1,17 @@
-"""The ball impact: Arlequin against the uniformly fine single meshes, in one process.
+"""The ball impact: Arlequin against the single-mesh references, in one process.
 
-Runs ``run_ball_impact`` with ``model="arlequin"`` and ``model="mono"`` on the same set-up
-(``mono-zoned`` and ``graded`` are not built yet: reported as such), and prints JSON: per model
-the wall time of the time loop, steps, elements, the quantities of interest (peak force,
-contact duration, restitution, dent depth, maximum ε̄p, energy balance) and their differences
-from ``mono``; p (the patches' elements over the uniform meshes'), the ratios T_mono /
-T_arlequin against the floor 0.8 / p, and the peak resident memory of the process (MB, at the
-end: the larger run's). The compiled J2 kernel is warmed up before timing.
+Runs ``run_ball_impact`` with the models ``arlequin``, ``mono`` (uniformly fine, J2 in the whole
+block), ``mono-zoned`` (uniformly fine, J2 in the patch region) and ``graded`` (conforming
+graded meshes, the laws of mono-zoned) on the same set-up, and prints JSON: per model the wall
+time of the time loop, steps, elements, the quantities of interest (peak force, contact
+duration, restitution, dent depth, maximum ε̄p, energy balance) and their differences from
+``mono``; p (the patches' elements over the uniform meshes'), the ratios T_mono / T_arlequin
+against the floor 0.8 / p, T_mono-zoned / T_arlequin, T_arlequin / T_graded against 1.3, and
+the peak resident memory of the process (MB, the largest run's). The compiled J2 kernel is
+warmed up before timing.
 
-    python benchmarks/ball_impact.py [--regime plastic] [--block-size 0.04] [--rigid-wall]
-        [--coarse-step-ratio 1]
+    python benchmarks/ball_impact.py [--regime plastic] [--block-size 0.02] [--rigid-wall]
+        [--coarse-step-ratio 1] [--coarse-size H] [--fine-size H] [--models arlequin,mono]
 """
 
 from __future__ import annotations
@@ -32,7 +34,8 @@ def _row(r) -> dict:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--regime", choices=["elastic", "plastic"], default="plastic")
-    parser.add_argument("--block-size", type=float, default=0.04, help="R_B = H_B (m)")
+    parser.add_argument("--block-size", type=float, default=0.02, help="R_B = H_B (m)")
+    parser.add_argument("--models", default="arlequin,mono,mono-zoned,graded")
     parser.add_argument("--rigid-wall", action="store_true")
     parser.add_argument("--coarse-step-ratio", type=int, default=1)
     parser.add_argument("--coarse-size", type=float, default=None)
@@ -45,22 +48,32 @@ def main(argv: list[str] | None = None) -> int:
     common = dict(regime=args.regime, block_radius=args.block_size,
                   block_height=args.block_size, rigid_wall=args.rigid_wall,
                   coarse_size=args.coarse_size, fine_size=args.fine_size)  # fmt: skip
-    arl = run_ball_impact(model="arlequin", coarse_step_ratio=args.coarse_step_ratio, **common)
-    mono = run_ball_impact(model="mono", **common)
+    runs = {}
+    for model in args.models.split(","):
+        ratio = args.coarse_step_ratio if model == "arlequin" else 1
+        runs[model] = run_ball_impact(model=model, coarse_step_ratio=ratio, **common)
+    first = next(iter(runs.values()))
     out = {"benchmark": "ball_impact", "regime": args.regime, "block_size_m": args.block_size,
            "rigid_wall": args.rigid_wall, "coarse_step_ratio": args.coarse_step_ratio,
-           "fine_size_m": arl.fine_size, "coarse_size_m": arl.coarse_size,
-           "patch_fraction_p": round(arl.patch_fraction, 5),
-           "arlequin": _row(arl), "mono": _row(mono),
-           "mono-zoned": "not built yet", "graded": "not built yet"}  # fmt: skip
-    for key, a, m in (("peak_force", arl.peak_force, mono.peak_force),
-                      ("contact_duration", arl.contact_duration, mono.contact_duration),
-                      ("restitution", arl.restitution, mono.restitution),
-                      ("dent_depth", arl.dent_depth, mono.dent_depth)):  # fmt: skip
-        out[f"{key}_difference_vs_mono"] = float(f"{a / m - 1:.3g}") if m else None
-    ratio = mono.wall_time_s / arl.wall_time_s
-    out["T_mono/T_arlequin"] = round(ratio, 3)
-    out["floor_0.8/p"] = round(0.8 / arl.patch_fraction, 2)
+           "fine_size_m": first.fine_size, "coarse_size_m": first.coarse_size}  # fmt: skip
+    for model, r in runs.items():
+        out[model] = _row(r)
+    mono, arl = runs.get("mono"), runs.get("arlequin")
+    if arl is not None:
+        out["patch_fraction_p"] = round(arl.patch_fraction, 5)
+        out["floor_0.8/p"] = round(0.8 / arl.patch_fraction, 2)
+    for model, r in runs.items():
+        if mono is None or model == "mono":
+            continue
+        for key in ("peak_force", "contact_duration", "restitution", "dent_depth"):
+            a, m = getattr(r, key), getattr(mono, key)
+            out[model][f"{key}_difference_vs_mono"] = float(f"{a / m - 1:.3g}") if m else None
+    if arl is not None:
+        for model in ("mono", "mono-zoned"):
+            if model in runs:
+                out[f"T_{model}/T_arlequin"] = round(runs[model].wall_time_s / arl.wall_time_s, 3)
+        if "graded" in runs:
+            out["T_arlequin/T_graded"] = round(arl.wall_time_s / runs["graded"].wall_time_s, 3)
     out["peak_memory_MB"] = round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, 1)
     print(json.dumps(out, indent=2))
     return 0

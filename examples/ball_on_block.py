@@ -91,10 +91,12 @@ def run(n: int = 20, levels: int = 2, velocity: float = 1.0, block_size: float =
     ball_patch = skfem.MeshQuad(p, ball_patch.t)
 
     # 2. the block: a tensor grid graded away from the contact point, the same kind of patch
-    growth = 1.15
-    k = round(math.log1p(block_size * (growth - 1) / h_c) / math.log(growth))
-    r = np.concatenate([[0.0], np.cumsum(h_c * growth ** np.arange(k))])
-    r *= block_size / r[-1]  # cells growing from h_c by 15%, the last node on the block's edge
+    # cells of h_c over the patch, then growing by 15%, the last node on the block's edge
+    growth, n_u = 1.15, math.ceil(reach / h_c - 1e-9)
+    start = n_u * h_c
+    k = round(math.log1p((block_size - start) * (growth - 1) / h_c) / math.log(growth))
+    x = np.concatenate([[0.0], np.cumsum(h_c * growth ** np.arange(k))])
+    r = np.concatenate([h_c * np.arange(n_u), start + x * ((block_size - start) / x[-1])])
     block_coarse = skfem.MeshQuad.init_tensor(r, np.concatenate([-r[::-1][:-1], [0.0]]))
     block_patch = arlequin.refine_region(block_coarse, levels, level_set=near_pole)
 

@@ -9,7 +9,13 @@ touches the block's top face z = 0 (radius R_B, height H_B, base on rollers) at 
     ``patch_size`` at the contact point, the contact between the two patches;
 ``mono``
     each body one mesh with the fine size everywhere (in the plastic regime the whole block
-    finite-strain J2: what a user runs without deciding where it yields).
+    finite-strain J2: what a user runs without deciding where it yields);
+``mono-zoned``
+    the same meshes, J2 only in the block's patch region, elastic elsewhere (the saving of the
+    law apart from the saving of the mesh);
+``graded``
+    one conforming mesh per body, the fine size at the contact point growing away from it (the
+    ball's graded O-grid, the block's graded grid), the laws of ``mono-zoned``.
 
 Regimes: ``elastic`` (both bodies elastic, steel on steel, v0 = 1 m/s by default: 2e-4 of the
 ball's bar wave speed, against Hertz's impact solution) and ``plastic`` (a copper block,
@@ -26,8 +32,7 @@ block's top point on the axis, after the run), the maximum equivalent plastic st
 balance of the integrator (kinetic + strain − works of the contact, coupling and supports,
 against the largest energy).
 
-``mono-zoned`` and ``graded`` (the other references of the issue) and multi-time-step by
-default are not built yet: they are refused with a clear error.
+Multi-time-step is not the default yet (``coarse_step_ratio=1``).
 
 Outputs (``out``): results.json (inputs and results with units), impact.csv (per step),
 history.csv and fields/*.xdmf (energies and fields per record, ParaView), ball_impact.png.
@@ -60,8 +65,6 @@ logger = logging.getLogger(__name__)
 
 MODELS = ("arlequin", "mono", "mono-zoned", "graded")
 REGIMES = ("elastic", "plastic")
-#: The models built so far (the others are refused).
-BUILT = ("arlequin", "mono")
 #: ε̄p in the block patch's gluing band above which a GluingBandPlasticityWarning is raised.
 BAND_WARNING = 0.02
 #: A uniform (``mono``) mesh above this many cells is refused before it is built.
@@ -98,6 +101,7 @@ def run_ball_impact(
     ball_material: IsotropicElastic | None = None,
     block_material: IsotropicElastic | J2Material | None = None,
     patch_size: float | None = None,
+    block_patch_size: float | None = None,
     fine_size: float | None = None,
     coarse_size: float | None = None,
     friction: float = 0.0,
@@ -113,8 +117,8 @@ def run_ball_impact(
     Parameters
     ----------
     regime : {"elastic", "plastic"}
-    model : {"arlequin", "mono"}
-        (``"mono-zoned"`` and ``"graded"`` are refused: not built yet.)
+    model : {"arlequin", "mono", "mono-zoned", "graded"}
+        See :class:`~arlequin.demos.ball_setup.ImpactBodies`.
     velocity : float, optional
         v0 (m/s); default 1 (elastic), 10 (plastic).
     ball_radius, block_radius, block_height : float
@@ -124,8 +128,11 @@ def run_ball_impact(
     block_material : IsotropicElastic or J2Material, optional
         Default steel (elastic regime) or :data:`COPPER` (plastic).
     patch_size : float, optional
-        Radius of the patches around the contact point (m); default 0.2 R (elastic), 0.4 R
-        (plastic).
+        Radius of the patches around the contact point (m), below R/2; default 0.2 R
+        (elastic), 0.4 R (plastic).
+    block_patch_size : float, optional
+        Radius of the block's patch (m), if larger (the plastic zone's extent); default
+        ``patch_size`` (elastic), 0.8 R (plastic; at most half the block's size).
     fine_size, coarse_size : float, optional
         Cell sizes (m) of the patches and of the coarse models at the contact; default
         coarse π R/120 (the ball's O-grid n = 30) and fine the largest power-of-two refinement
@@ -158,9 +165,6 @@ def run_ball_impact(
         raise ValueError(f"regime must be one of {REGIMES}, got {regime!r}")
     if model not in MODELS:
         raise ValueError(f"model must be one of {MODELS}, got {model!r}")
-    if model not in BUILT:
-        raise ValueError(f"model={model!r} is not built yet (built: {BUILT}); see the ball-impact "
-                         "issue")  # fmt: skip
     plastic = regime == "plastic"
     velocity = (10.0 if plastic else 1.0) if velocity is None else _positive("velocity", velocity)
     big = _positive("ball_radius", ball_radius)
@@ -203,8 +207,17 @@ def run_ball_impact(
     if reach >= 0.5 * big or reach >= min(block_radius, block_height):
         raise ValueError(f"patch_size={reach:.4g} m must stay below half the ball radius and the "
                          "block's size")  # fmt: skip
-    sizes = ball_sizes(big, coarse, fine, reach)
-    if model == "mono":
+    if block_patch_size is not None:
+        block_reach = _positive("block_patch_size", block_patch_size)
+    elif plastic:  # the plastic zone reaches beyond the contact radius
+        block_reach = max(reach, min(0.8 * big, 0.5 * min(block_radius, block_height)))
+    else:
+        block_reach = reach
+    if block_reach < reach or block_reach >= 0.9 * min(block_radius, block_height):
+        raise ValueError(f"block_patch_size={block_reach:.4g} m must lie between patch_size="
+                         f"{reach:.4g} m and 0.9 of the block's size")  # fmt: skip
+    sizes = ball_sizes(big, coarse, fine, reach, block_reach)
+    if model in ("mono", "mono-zoned"):
         cells = _mono_cells(sizes, big, block_radius, block_height, rigid_wall)
         if cells > MONO_LIMIT:
             raise ValueError(f"the uniform (mono) meshes would have {cells} cells at the fine "
@@ -214,6 +227,7 @@ def run_ball_impact(
         t_end = _positive("t_end", t_end)
     config = {"regime": regime, "model": model, "velocity": velocity, "ball_radius": big,
               "block_radius": block_radius, "block_height": block_height, "patch_size": reach,
+              "block_patch_size": block_reach,
               "fine_size": fine_size, "coarse_size": coarse_size, "friction": friction,
               "rigid_wall": bool(rigid_wall), "coarse_step_ratio": int(coarse_step_ratio),
               "t_end": t_end, "ball_material": repr(ball_material),
@@ -265,12 +279,14 @@ def _run(config, sizes, ball_material, block_material, out, progress) -> BallImp
     wall = time.perf_counter() - tic
     mono = _mono_cells(sizes, big, config["block_radius"], config["block_height"],
                        config["rigid_wall"])  # fmt: skip
-    p = bodies.fine_elements / mono if config["model"] == "arlequin" else 1.0
+    # Arlequin: its patches' elements; a reference: all its elements, over the uniform meshes'
+    p = (bodies.fine_elements if config["model"] == "arlequin" else bodies.n_elements) / mono
     result = recorder.result(res, wall, p, values, config)
     if result.band_max_plastic_strain > BAND_WARNING:
         warnings.warn(f"equivalent plastic strain in the block's gluing band reaches "
                       f"{result.band_max_plastic_strain:.4f} > {BAND_WARNING}: the coarse model "
-                      f"glued there is elastic; enlarge the patch (patch_size={sizes.reach:.4g} m)",
+                      f"glued there is elastic; enlarge it (block_patch_size="
+                      f"{sizes.block_patch:.4g} m)",
                       GluingBandPlasticityWarning, stacklevel=2)  # fmt: skip
     if folder is not None:
         write_outputs(folder, result, bodies, res)

@@ -39,43 +39,67 @@ GROWTH = 1.15
 INNER = 0.45
 
 
-def _block(inner: np.ndarray, arc: np.ndarray, layers: int) -> tuple[np.ndarray, np.ndarray]:
-    """Points (2, (k+1)(layers+1)) and quads of the linear blend from the polyline ``inner``
-    (2, k+1) to ``arc`` (2, k+1), both running with the arc's angle."""
+def _block(inner: np.ndarray, arc: np.ndarray, layers: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Points (2, (k+1)(L+1)) and quads of the linear blend from the polyline ``inner``
+    (2, k+1) to ``arc`` (2, k+1), both running with the arc's angle, at the fractions
+    ``layers`` (L+1,) from 0 (inner) to 1 (arc)."""
     k = inner.shape[1] - 1
-    s = np.linspace(0.0, 1.0, layers + 1)
+    s = np.asarray(layers, dtype=float)
     pts = (1 - s)[None, :, None] * inner[:, None, :] + s[None, :, None] * arc[:, None, :]
     pts = pts.reshape(2, -1)  # index j (k+1) + i: layer j, station i
-    i, j = np.meshgrid(np.arange(k), np.arange(layers), indexing="ij")
+    i, j = np.meshgrid(np.arange(k), np.arange(s.size - 1), indexing="ij")
     a = (j * (k + 1) + i).ravel()
     # stations run with the angle, layers outwards: the corner order of skfem's tensor quads
     quads = np.stack([a, a + 1, a + k + 2, a + k + 1])
     return pts, quads
 
 
-def half_disk_mesh(radius: float, n: int) -> skfem.MeshQuad:
-    """The meridional half disk r ≥ 0 of a ball of radius ``radius`` (m) centred at (0, R):
-    an O-grid of 6 n² quads (module docstring)."""
-    if int(n) != n or n < 1:
-        raise ValueError(f"the ball's O-grid needs n >= 1 cells per inner side, got n={n}")
-    n = int(n)
+def half_disk_mesh(radius: float, n: int, pole_spacing: float | None = None,
+                   growth: float = GROWTH, uniform: float = 0.0) -> skfem.MeshQuad:  # fmt: skip
+    """The meridional half disk r ≥ 0 of a ball of radius ``radius`` (m) centred at (0, R).
+
+    Without ``pole_spacing``: the uniform O-grid of 6 n² quads (module docstring). With it
+    (m): a conforming graded O-grid, cells of that size at the south pole (up to the distance
+    ``uniform``, m, along the arc and inwards) then growing by ``growth`` along the arc
+    (mirrored at the north pole, the inner block's radial lines being shared), and layers
+    growing by ``growth`` inwards from the sphere (all around it: the outer blocks share their
+    layers); the right block's cells along the arc match the last graded ones. ``n`` is then
+    unused.
+    """
     big = float(radius)
     s = INNER * big
-    parts = []
-    q = skfem.MeshQuad.init_tensor(np.linspace(0.0, s, n + 1), np.linspace(-s, s, 2 * n + 1))
-    parts.append((q.p, q.t))
+    if pole_spacing is None:
+        if int(n) != n or n < 1:
+            raise ValueError(f"the ball's O-grid needs n >= 1 cells per inner side, got n={n}")
+        n = int(n)
+        phi = np.linspace(0.0, 0.25 * np.pi, n + 1)
+        z_in = np.linspace(-s, s, 2 * n + 1)
+        layers = np.linspace(0.0, 1.0, n + 1)
+    else:
+        if not 0.0 < pole_spacing < 0.1 * big:
+            raise ValueError(f"pole_spacing must lie in (0, 0.1 R), got {pole_spacing}")
+        phi = graded_coordinates(pole_spacing / big, 0.25 * np.pi, growth, uniform / big)
+        last = big * (phi[-1] - phi[-2])
+        m = max(1, round(0.25 * np.pi * big / last))
+        z_in = np.linspace(-s, s, 2 * m + 1)
+        layers = 1.0 - graded_coordinates(pole_spacing / (big - s), 1.0, growth,
+                                          uniform / (big - s))[::-1]  # fmt: skip
+        layers[0] = 0.0
+    r_in = s * phi / phi[-1]
+    k = r_in.size - 1
+    q = skfem.MeshQuad.init_tensor(r_in, z_in)
+    parts = [(q.p, q.t)]
 
-    def arc(t0: float, t1: float, k: int) -> np.ndarray:
-        th = np.radians(np.linspace(t0, t1, k + 1))
-        return big * np.stack([np.cos(th), np.sin(th)])
+    def arc(theta: np.ndarray) -> np.ndarray:
+        return big * np.stack([np.cos(theta), np.sin(theta)])
 
-    line = np.linspace(0.0, 1.0, n + 1)
-    bottom = np.stack([s * line, np.full(n + 1, -s)])
-    right = np.stack([np.full(2 * n + 1, s), np.linspace(-s, s, 2 * n + 1)])
-    top = np.stack([s * (1 - line), np.full(n + 1, s)])
-    for edge, a in ((bottom, arc(-90.0, -45.0, n)), (right, arc(-45.0, 45.0, 2 * n)),
-                    (top, arc(45.0, 90.0, n))):  # fmt: skip
-        parts.append(_block(edge, a, n))
+    bottom = np.stack([r_in, np.full(k + 1, -s)])
+    right = np.stack([np.full(z_in.size, s), z_in])
+    top = np.stack([r_in[::-1], np.full(k + 1, s)])
+    theta_right = np.linspace(-0.25 * np.pi, 0.25 * np.pi, z_in.size)
+    for edge, a in ((bottom, arc(-0.5 * np.pi + phi)), (right, arc(theta_right)),
+                    (top, arc(0.5 * np.pi - phi[::-1]))):  # fmt: skip
+        parts.append(_block(edge, a, layers))
     pts = np.concatenate([p for p, _ in parts], axis=1)
     offsets = np.cumsum([0] + [p.shape[1] for p, _ in parts[:-1]])
     cells = np.concatenate([t + o for (_, t), o in zip(parts, offsets)], axis=1)
@@ -114,24 +138,31 @@ def ball_patch_mesh(coarse: skfem.MeshQuad, radius: float, reach: float,
     return snap_to_sphere(patch, radius, gap=1.5 * longest**2 / (8.0 * radius))
 
 
-def graded_coordinates(first: float, length: float, growth: float = GROWTH) -> np.ndarray:
-    """0 = x₀ < x₁ < … < x_k = ``length`` (m): cells growing from ``first`` by ``growth``,
-    scaled so that the last node lands on ``length``."""
+def graded_coordinates(first: float, length: float, growth: float = GROWTH,
+                       uniform: float = 0.0) -> np.ndarray:  # fmt: skip
+    """0 = x₀ < x₁ < … < x_k = ``length`` (m): cells of size ``first`` up to ``uniform`` (m),
+    then growing from ``first`` by ``growth``, the graded part scaled so that the last node
+    lands on ``length``."""
     if not (first > 0.0 and length > 0.0):
         raise ValueError(f"graded coordinates need first > 0 and length > 0, got {first}, {length}")
-    if growth == 1.0:
+    n_u = int(np.ceil(uniform / first - 1e-9)) if uniform > 0.0 else 0
+    if growth == 1.0 or n_u * first >= length:
         return np.linspace(0.0, length, max(1, round(length / first)) + 1)
-    k = max(1, round(np.log1p(length * (growth - 1.0) / first) / np.log(growth)))
+    start = n_u * first
+    rest = length - start
+    k = max(1, round(np.log1p(rest * (growth - 1.0) / first) / np.log(growth)))
     x = np.concatenate([[0.0], np.cumsum(first * growth ** np.arange(k))])
-    return x * (length / x[-1])
+    graded = start + x * (rest / x[-1])
+    return np.concatenate([first * np.arange(n_u), graded])
 
 
-def block_mesh(radius: float, height: float, first: float,
-               growth: float = GROWTH) -> skfem.MeshQuad:  # fmt: skip
-    """The block's meridional rectangle [0, R_B] × [−H_B, 0] (m), cells graded away from the
-    origin from ``first`` (``growth`` = 1: uniform)."""
-    r = graded_coordinates(first, radius, growth)
-    z = -graded_coordinates(first, height, growth)[::-1]
+def block_mesh(radius: float, height: float, first: float, growth: float = GROWTH,
+               uniform: float = 0.0) -> skfem.MeshQuad:  # fmt: skip
+    """The block's meridional rectangle [0, R_B] × [−H_B, 0] (m): cells of size ``first`` up to
+    ``uniform`` (m) from the contact point along r and z, then growing by ``growth`` (1:
+    uniform everywhere)."""
+    r = graded_coordinates(first, radius, growth, uniform)
+    z = -graded_coordinates(first, height, growth, uniform)[::-1]
     z[-1] = 0.0
     return skfem.MeshQuad.init_tensor(r, z)
 

@@ -25,7 +25,8 @@ HISTORY_UNITS = {"t": "s", "contact_force": "N", "ball_velocity": "m/s", "kineti
                   "elastic": "J", "plastic_dissipation": "J", "contact_work": "J",
                   "coupling_work": "J"}  # fmt: skip
 INPUT_UNITS = {"regime": "", "model": "", "velocity": "m/s", "ball_radius": "m",
-               "block_radius": "m", "block_height": "m", "patch_size": "m", "fine_size": "m",
+               "block_radius": "m", "block_height": "m", "patch_size": "m",
+               "block_patch_size": "m", "fine_size": "m",
                "coarse_size": "m", "friction": "1", "rigid_wall": "", "coarse_step_ratio": "1",
                "t_end": "s", "ball_material": "", "block_material": ""}  # fmt: skip
 RESULT_UNITS = {"contact_duration": "s", "peak_force": "N", "restitution": "1",
@@ -63,13 +64,15 @@ class BallImpactResult(JsonResult):
         The integrator's balance error over the run against the largest energy (1).
     patch_fraction : float
         p: the patches' elements over those of the uniformly fine (``mono``) meshes of both
-        bodies (1; the Arlequin model's, 1 for ``mono``).
+        bodies (1); for the references, all their elements over the uniform meshes' (1 for
+        ``mono`` and ``mono-zoned``).
     n_elements : int
         Elements of the run (every mesh).
     wall_time_s : float
         Wall time of the time loop (s).
     history : dict
-        Per step (decimated to at most 2000 points in the JSON): ``t`` (s), ``contact_force``
+        Per sample (1000 over the run, :data:`~arlequin.demos.ball_record.SAMPLES`; every step
+        of a shorter run): ``t`` (s), ``contact_force``
         (N), ``ball_velocity`` (m/s, along z), ``kinetic``, ``elastic`` (strain energy of the
         elastic models and stored energy of the J2 one), ``plastic_dissipation``,
         ``contact_work``, ``coupling_work`` (J).

@@ -38,7 +38,8 @@ from ..models import (
     RigidContactPair,
 )
 from ..problem import ArlequinProblem, Patch
-from .ball_meshes import ball_patch_mesh, block_mesh, block_patch_mesh, half_disk_mesh
+from .ball_meshes import GROWTH, ball_patch_mesh, block_mesh, block_patch_mesh, half_disk_mesh
+from .ball_zoned import ZonedBody
 
 __all__ = ["ARC", "BallSizes", "ImpactBodies", "ball_sizes"]
 
@@ -63,11 +64,19 @@ class BallSizes:
     reach: float
     gluing: float
     zone: float
+    block_reach: float = 0.0
+
+    @property
+    def block_patch(self) -> float:
+        """The block patch's radius (m): ``block_reach``, or the ball's ``reach``."""
+        return self.block_reach or self.reach
 
 
-def ball_sizes(radius: float, coarse_size: float, fine_size: float, reach: float) -> BallSizes:
+def ball_sizes(radius: float, coarse_size: float, fine_size: float, reach: float,
+               block_reach: float | None = None) -> BallSizes:  # fmt: skip
     """The sizes of the patches from the requested ones (m): the coarse size rounded to the
-    ball's O-grid, the fine size to a power-of-two refinement of it."""
+    ball's O-grid, the fine size to a power-of-two refinement of it; ``block_reach`` the
+    block patch's radius if it differs from the ball's ``reach``."""
     n = max(2, math.ceil(ARC * radius / coarse_size - 1e-9))
     coarse = ARC * radius / n
     levels = max(1, round(math.log2(coarse / fine_size)))
@@ -77,7 +86,8 @@ def ball_sizes(radius: float, coarse_size: float, fine_size: float, reach: float
         raise ValueError(f"patch_size={reach:.4g} m leaves no contact zone below the gluing band "
                          f"(two coarse cells of {coarse:.4g} m): give patch_size > "
                          f"{4 * coarse:.4g} m")  # fmt: skip
-    return BallSizes(coarse, coarse / 2**levels, n, levels, reach, gluing, zone)
+    return BallSizes(coarse, coarse / 2**levels, n, levels, reach, gluing, zone,
+                     float(block_reach or 0.0))  # fmt: skip
 
 
 def _axis(x: np.ndarray, tol: float) -> np.ndarray:
@@ -89,7 +99,12 @@ class ImpactBodies:
 
     Parameters
     ----------
-    model : {"arlequin", "mono"}
+    model : {"arlequin", "mono", "mono-zoned", "graded"}
+        ``mono-zoned``: the uniform meshes with J2 only in the block's patch region (the cells
+        whose centre lies within ``sizes.block_patch`` of the contact point), elastic elsewhere;
+        ``graded``: one conforming mesh per body, the fine size at the contact point growing by
+        :data:`~arlequin.demos.ball_meshes.GROWTH` a cell away from it (the ball's graded
+        O-grid), the same laws as ``mono-zoned``.
     sizes : BallSizes
     ball_radius, block_radius, block_height : float
         R, R_B, H_B (m).
@@ -115,7 +130,11 @@ class ImpactBodies:
         self.plastic = isinstance(block_material, J2Material)
         bodies: dict[str, Any] = {}
         self.meshes: dict[str, Any] = {}
-        ball_coarse = half_disk_mesh(big, s.n if model == "arlequin" else s.n * 2**s.levels)
+        if model == "graded":
+            ball_coarse = half_disk_mesh(big, 0, pole_spacing=s.fine, uniform=s.reach)
+        else:
+            ball_coarse = half_disk_mesh(big, s.n if model == "arlequin" else s.n * 2**s.levels)
+        self.zoned: ZonedBody | None = None
         if model == "arlequin":
             ball_fine = ball_patch_mesh(ball_coarse, big, s.reach, s.levels)
             bodies["ball"] = self._pair(ball_coarse, ball_fine, ball_material, ball_material)
@@ -126,13 +145,23 @@ class ImpactBodies:
         if not rigid_wall:
             elastic = block_material.elastic if self.plastic else block_material
             if model == "arlequin":
-                bc = block_mesh(block_radius, block_height, s.coarse)
-                bf = block_patch_mesh(bc, s.reach, s.levels)
+                bc = block_mesh(block_radius, block_height, s.coarse, uniform=s.block_patch)
+                bf = block_patch_mesh(bc, s.block_patch, s.levels)
                 bodies["block"] = self._pair(bc, bf, elastic, block_material)
                 self.meshes.update({"block.coarse": bc, "block.patch": bf})
             else:
-                bc = block_mesh(block_radius, block_height, s.fine, growth=1.0)
-                bodies["block"] = self._single(bc, block_material)
+                # mono, mono-zoned: uniformly fine; graded: fine at the contact, growing away
+                growth = GROWTH if model == "graded" else 1.0
+                bc = block_mesh(block_radius, block_height, s.fine, growth=growth,
+                                uniform=s.block_patch)  # fmt: skip
+                if self.plastic and model in ("mono-zoned", "graded"):
+                    centres = bc.p[:, bc.t].mean(axis=1)
+                    zone_cells = np.nonzero(np.hypot(centres[0], centres[1]) < s.block_patch)[0]
+                    self.zoned = ZonedBody(bc, zone_cells, block_material)
+                    self.zoned.add_dirichlet("coarse", lambda x: _axis(x, tol), components=[0])
+                    bodies["block"] = self.zoned
+                else:
+                    bodies["block"] = self._single(bc, block_material)
                 self.meshes["block.coarse"] = bc
             bodies["block"].add_dirichlet("coarse", lambda x: x[1] < -block_height + tol,
                                           components=[1])  # fmt: skip
@@ -233,8 +262,41 @@ class ImpactBodies:
         dofs = self.system.dofmap[self.block_block]
         return float(-u[dofs.offset + 2 * self._pole + 1])
 
-    def plastic_model(self):
-        """The block's finite-strain J2 model and its block name, or (None, None)."""
+    def plastic_part(self) -> tuple[Any, str, int, Any, Any] | None:
+        """The block's finite-strain J2 term: (model, block name, term index, weight, transfer
+        from the block's dofs), or None in the elastic regime."""
         if not self.plastic or self.block_block is None:
-            return None, None
-        return self.system.block(self.block_block).model, self.block_block
+            return None
+        if self.zoned is not None:
+            return self.zoned.j2, self.block_block, 1, None, self.zoned.transfer
+        term = self.system.block(self.block_block).terms[0]
+        return term.model, self.block_block, 0, term.weight, None
+
+    def block_energies(self, u: np.ndarray, states: dict) -> tuple[float, float]:
+        """(elastic energy, plastic dissipation) (J) of the block carrying the J2 law."""
+        part = self.plastic_part()
+        if part is None:
+            return 0.0, 0.0
+        model, block, index, weight, transfer = part
+        ub = u[self.system.dofmap[block].slice]
+        state = states[block][index]
+        uj = ub if transfer is None else transfer @ ub
+        elastic = model.stored_energy(uj, state, weight)
+        if self.zoned is not None:
+            k = self.system.block(block).terms[0].model.stiffness_matrix
+            elastic += 0.5 * float(ub @ (k @ ub))
+        return elastic, model.plastic_dissipation(state, weight)
+
+    def plastic_strain(self, states: dict) -> tuple[Any, np.ndarray] | None:
+        """(the J2 mesh, its cell-mean ε̄p) or None."""
+        part = self.plastic_part()
+        if part is None:
+            return None
+        model, block, index, _, _ = part
+        return model.mesh, states[block][index].eqps.mean(axis=1)
+
+    def j2_displacement(self, u: np.ndarray) -> np.ndarray:
+        """The J2 mesh's displacement dofs (m) from the system's ``u``."""
+        _, block, _, _, transfer = self.plastic_part()
+        ub = u[self.system.dofmap[block].slice]
+        return ub if transfer is None else transfer @ ub
