@@ -39,6 +39,10 @@ def _is_problem(body: Any) -> bool:
                                                                         None))  # fmt: skip
 
 
+def _join(body: str, block: str) -> str:
+    return f"{body}{SEPARATOR}{block}"
+
+
 def _shift_columns(matrix: sp.spmatrix, offset: int, n: int) -> sp.csr_matrix:
     """The rows of ``matrix`` (m, n_b) acting on the columns offset…offset + n_b of (m, n)."""
     coo = sp.coo_matrix(matrix)
@@ -75,15 +79,29 @@ class MultiBodyProblem:
             else:
                 check_protocol(body, Model, f"body {name!r} (an ArlequinProblem or a model)")
                 model = body
-            dims[name] = int(model.mesh.dim())
-        if len(set(dims.values())) > 1:
-            raise ValueError(f"the bodies' meshes have different dimensions: {dims}")
+            dims[name] = (int(model.mesh.dim()), getattr(model, "kind", None))
+        if len({d for d, _ in dims.values()}) > 1 or len({k for _, k in dims.values()}) > 1:
+            raise ValueError(f"the bodies' meshes have different dimensions or kinds (plane "
+                             f"strain, axisymmetric...): {dims}")  # fmt: skip
         self._systems: dict[str, CoupledSystem] | None = None
 
-    @staticmethod
-    def block_name(body: str, block: str = "coarse") -> str:
-        """The assembled name of a body's block (``"ball.patch"``)."""
-        return f"{body}{SEPARATOR}{block}"
+    def block_name(self, body: str, block: str | None = None) -> str:
+        """The assembled name of a body's block (``"ball.patch"``); ``block`` None: the body's
+        first block (``"coarse"`` of a problem, ``"model"`` of a bare model).
+
+        Raises
+        ------
+        ValueError
+            An unknown body or block, naming the known ones.
+        """
+        if body not in self.bodies:
+            raise ValueError(f"unknown body {body!r}; bodies are {list(self.bodies)}")
+        names = [b.name for b in self.body_systems()[body].blocks]
+        if block is None:
+            block = names[0]
+        if block not in names:
+            raise ValueError(f"body {body!r} has no block {block!r}; its blocks are {names}")
+        return _join(body, block)
 
     def body_systems(self) -> dict[str, CoupledSystem]:
         """Each body's own coupled system (built once)."""
@@ -100,13 +118,12 @@ class MultiBodyProblem:
     @property
     def block_names(self) -> list[str]:
         """Every block of the assembled system, body by body."""
-        return [self.block_name(b, blk.name) for b, s in self.body_systems().items()
-                for blk in s.blocks]  # fmt: skip
+        return [_join(b, blk.name) for b, s in self.body_systems().items() for blk in s.blocks]
 
     def system(self) -> CoupledSystem:
         """The assembled system: the bodies' blocks, constraints and loads side by side."""
         systems = self.body_systems()
-        blocks = [Block(self.block_name(b, blk.name), blk.model, blk.terms)
+        blocks = [Block(_join(b, blk.name), blk.model, blk.terms)
                   for b, s in systems.items() for blk in s.blocks]  # fmt: skip
         offsets = {}
         n = 0
@@ -139,8 +156,8 @@ class MultiBodyProblem:
             layout = (body.field_layout() if _is_problem(body)
                       else FieldLayout.of_system(self.body_systems()[b]))  # fmt: skip
             for bf in layout.blocks:
-                blocks.append(BlockFields(self.block_name(b, bf.name), bf.mesh, bf.n_components,
+                blocks.append(BlockFields(_join(b, bf.name), bf.mesh, bf.n_components,
                                           dict(bf.cell_data)))  # fmt: skip
             for key, (carrier, dofs) in layout.multipliers.items():
-                multipliers[f"{b}{SEPARATOR}{key}"] = (self.block_name(b, carrier), dofs)
+                multipliers[_join(b, key)] = (_join(b, carrier), dofs)
         return FieldLayout(blocks, multipliers)

@@ -78,14 +78,16 @@ def add_ball_impact(sub) -> None:
                    help="block radius (m)")
     p.add_argument("--block-height", type=float, default=0.1, metavar="HB",
                    help="block height (m)")
-    for body in ("ball", "block"):
+    for body, plastic in (("ball", ""), ("block", " (plastic regime: copper, ")):
         p.add_argument(f"--{body}-young", type=float, default=None, metavar="E",
-                       help=f"{body} Young's modulus (Pa); default steel 210e9 (plastic block: "
-                       "copper 117e9)")  # fmt: skip
+                       help=f"{body} Young's modulus (Pa); default steel, 210e9"
+                       + (f"{plastic}117e9)" if plastic else ""))  # fmt: skip
         p.add_argument(f"--{body}-poisson", type=float, default=None, metavar="NU",
-                       help=f"{body} Poisson's ratio; default 0.3 (plastic block 0.35)")
+                       help=f"{body} Poisson's ratio; default 0.3"
+                       + (f"{plastic}0.35)" if plastic else ""))  # fmt: skip
         p.add_argument(f"--{body}-density", type=float, default=None, metavar="RHO",
-                       help=f"{body} density (kg/m^3); default 7850 (plastic block 8930)")
+                       help=f"{body} density (kg/m^3); default 7850"
+                       + (f"{plastic}8930)" if plastic else ""))  # fmt: skip
     p.add_argument("--block-yield-stress", type=float, default=None, metavar="S",
                    help="block yield stress (Pa; plastic regime); default 0.4e9")
     p.add_argument("--block-hardening", type=float, default=None, metavar="H",

@@ -61,7 +61,7 @@ def ball_mesh(radius: float, n: int) -> skfem.MeshQuad:
     p = p[:, first]
     p[1] += radius
     p[0, np.abs(p[0]) < 1e-12 * radius] = 0.0
-    return skfem.MeshQuad(p, inverse.ravel()[t])
+    return skfem.MeshQuad(np.ascontiguousarray(p), np.ascontiguousarray(inverse.ravel()[t]))
 
 
 def run(n: int = 20, levels: int = 2, velocity: float = 1.0, block_size: float = 0.1) -> dict:

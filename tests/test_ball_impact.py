@@ -110,6 +110,13 @@ def test_bodies_side_by_side_move_as_they_do_alone():
     np.testing.assert_array_equal(r.u[system.dofmap["a.coarse"].slice], alone[0].u)
     np.testing.assert_array_equal(r.u[system.dofmap["b.coarse"].slice], alone[1].u)
     assert [bf.name for bf in both.field_layout().blocks] == ["a.coarse", "b.coarse"]
+    assert both.block_name("b") == "b.coarse"
+    with pytest.raises(ValueError, match="has no block 'patch'"):
+        both.block_name("a", "patch")
+    with pytest.raises(ValueError, match="unknown body"):
+        both.block_name("c")
+    bare = MultiBodyProblem({"x": _bar(0.0).model("coarse")})
+    assert bare.block_name("x") == "x.model"
     with pytest.raises(ValueError, match="body names must be non-empty strings"):
         MultiBodyProblem({"a.b": _bar(0.0)})
     with pytest.raises(ValueError, match="at least one body"):
@@ -175,6 +182,8 @@ def test_bad_input_is_refused_before_any_work():
                           ({"regime": "plastic", "rigid_wall": True}, "rigid_wall"),
                           ({"block_material": STEEL, "regime": "plastic"}, "J2Material"),
                           ({"model": "mono"}, "would have"),
+                          ({"fine_size": 1e-7}, "the patches would hold"),
+                          ({"rigid_wall": True, "block_material": STEEL}, "no effect"),
                           ({"coarse_step_ratio": 0}, "coarse_step_ratio")):  # fmt: skip
         with pytest.raises(ValueError, match=match):
             run_ball_impact(**kwargs, check_only=True)

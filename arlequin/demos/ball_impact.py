@@ -67,6 +67,8 @@ MODELS = ("arlequin", "mono", "mono-zoned", "graded")
 REGIMES = ("elastic", "plastic")
 #: ε̄p in the block patch's gluing band above which a GluingBandPlasticityWarning is raised.
 BAND_WARNING = 0.02
+#: Patches above about this many cells are refused before they are built.
+PATCH_LIMIT = 2_000_000
 #: A uniform (``mono``) mesh above this many cells is refused before it is built.
 MONO_LIMIT = 400_000
 #: The default coarse size over R: the ball's O-grid with n = 30 (π/4 R / 30 along the arc).
@@ -174,6 +176,8 @@ def run_ball_impact(
     if not isinstance(ball_material, IsotropicElastic):
         raise ValueError(f"ball_material must be an IsotropicElastic (the ball stays elastic), "
                          f"got {type(ball_material).__name__}")  # fmt: skip
+    if rigid_wall and block_material is not None:
+        raise ValueError("block_material has no effect with rigid_wall (there is no block)")
     if block_material is None:
         block_material = COPPER if plastic else STEEL
     if plastic != isinstance(block_material, J2Material):
@@ -181,7 +185,8 @@ def run_ball_impact(
                          f"{'a J2Material' if plastic else 'an IsotropicElastic'}, got "
                          f"{type(block_material).__name__}")  # fmt: skip
     if rigid_wall and plastic:
-        raise ValueError("the plastic regime is the block's: rigid_wall is for the elastic ball")
+        raise ValueError("rigid_wall removes the block, and the plastic regime is the block's "
+                         "yielding: give one of them")  # fmt: skip
     if not (math.isfinite(friction) and friction >= 0.0):
         raise ValueError(f"friction must be a non-negative number, got friction={friction}")
     if isinstance(coarse_step_ratio, bool) or int(coarse_step_ratio) != coarse_step_ratio or \
@@ -204,19 +209,31 @@ def run_ball_impact(
         raise ValueError(f"fine_size={fine:.4g} m must be smaller than coarse_size={coarse:.4g} m")
     reach = (0.4 if plastic else 0.2) * big if patch_size is None else _positive(
         "patch_size", patch_size)  # fmt: skip
-    if reach >= 0.5 * big or reach >= min(block_radius, block_height):
-        raise ValueError(f"patch_size={reach:.4g} m must stay below half the ball radius and the "
-                         "block's size")  # fmt: skip
+    block_size = math.inf if rigid_wall else min(block_radius, block_height)
+    if reach >= 0.5 * big or reach >= block_size:
+        what = "half the ball radius" + ("" if rigid_wall else " and the block's size")
+        raise ValueError(f"the patches' radius {reach:.4g} m (patch_size) must stay below "
+                         f"{what}")  # fmt: skip
     if block_patch_size is not None:
         block_reach = _positive("block_patch_size", block_patch_size)
     elif plastic:  # the plastic zone reaches beyond the contact radius
-        block_reach = max(reach, min(0.8 * big, 0.5 * min(block_radius, block_height)))
+        block_reach = max(reach, min(0.8 * big, 0.5 * block_size))
     else:
         block_reach = reach
-    if block_reach < reach or block_reach >= 0.9 * min(block_radius, block_height):
+    if not rigid_wall and (block_reach < reach or block_reach >= 0.9 * block_size):
         raise ValueError(f"block_patch_size={block_reach:.4g} m must lie between patch_size="
                          f"{reach:.4g} m and 0.9 of the block's size")  # fmt: skip
     sizes = ball_sizes(big, coarse, fine, reach, block_reach)
+    # the patches' cells, about: their half discs at the fine size (the block's too)
+    patch_cells = 0.5 * math.pi * (reach**2 + (0.0 if rigid_wall else block_reach**2)) \
+        / sizes.fine**2
+    if patch_cells > PATCH_LIMIT:
+        raise ValueError(f"the patches would hold about {patch_cells:.3g} cells at the fine size "
+                         f"{sizes.fine:.4g} m (limit {PATCH_LIMIT:.3g}): a larger fine_size or "
+                         "smaller patches")  # fmt: skip
+    if abs(sizes.fine - fine) > 1e-9 * fine:
+        logger.info("fine size %.4g m rounded to %.4g m (coarse %.4g m / 2^%d)", fine,
+                    sizes.fine, sizes.coarse, sizes.levels)
     if model in ("mono", "mono-zoned"):
         cells = _mono_cells(sizes, big, block_radius, block_height, rigid_wall)
         if cells > MONO_LIMIT:
@@ -234,6 +251,15 @@ def run_ball_impact(
               "block_material": repr(block_material)}  # fmt: skip
     if check_only:
         return None
+    if not plastic:
+        bar_speed = math.sqrt(ball_material.young / ball_material.density)
+        if velocity > 1e-3 * bar_speed:
+            logger.warning("velocity %.4g m/s is above 1e-3 of the ball's bar wave speed "
+                           "(%.4g m/s): Hertz's quasi-static solution is only a guide", velocity,
+                           bar_speed)  # fmt: skip
+        if not rigid_wall and block_size < 10.0 * big:
+            logger.warning("a block under 10 ball radii (%.4g m) is not the half-space of "
+                           "Hertz's solution", block_size)
     return _run(config, sizes, ball_material, block_material, out, progress)
 
 
@@ -281,7 +307,13 @@ def _run(config, sizes, ball_material, block_material, out, progress) -> BallImp
                        config["rigid_wall"])  # fmt: skip
     # Arlequin: its patches' elements; a reference: all its elements, over the uniform meshes'
     p = (bodies.fine_elements if config["model"] == "arlequin" else bodies.n_elements) / mono
-    result = recorder.result(res, wall, p, values, config)
+    try:
+        result = recorder.result(res, wall, p, values, config)
+    except ValueError as exc:  # still in contact at the end: the folder says so
+        if folder is not None:
+            folder.finish("failed", str(exc))
+        raise
+    result.t_end = float(t_end)
     if result.band_max_plastic_strain > BAND_WARNING:
         warnings.warn(f"equivalent plastic strain in the block's gluing band reaches "
                       f"{result.band_max_plastic_strain:.4f} > {BAND_WARNING}: the coarse model "

@@ -110,7 +110,7 @@ def half_disk_mesh(radius: float, n: int, pole_spacing: float | None = None,
     cells = inverse.ravel()[cells]
     pts[1] += big
     pts[0, np.abs(pts[0]) < 1e-12 * big] = 0.0
-    return skfem.MeshQuad(pts, cells)
+    return skfem.MeshQuad(np.ascontiguousarray(pts), np.ascontiguousarray(cells))
 
 
 def snap_to_sphere(mesh: skfem.Mesh, radius: float, gap: float) -> skfem.Mesh:
@@ -124,7 +124,7 @@ def snap_to_sphere(mesh: skfem.Mesh, radius: float, gap: float) -> skfem.Mesh:
     near = nodes[(radius - dist[nodes] <= gap) & (dist[nodes] > 0.0)]
     p[:, near] = centre[:, None] + d[:, near] * (radius / dist[near])
     p[0, np.abs(p[0]) < 1e-12 * radius] = 0.0
-    return type(mesh)(p, mesh.t)
+    return type(mesh)(np.ascontiguousarray(p), np.ascontiguousarray(mesh.t))
 
 
 def ball_patch_mesh(coarse: skfem.MeshQuad, radius: float, reach: float,

@@ -181,7 +181,9 @@ def _picture(result: BallImpactResult, bodies, res, path: str) -> None:
         pc = PolyCollection(polygons(mesh, bodies.j2_displacement(res.u)), array=eqps,
                             cmap="viridis", edgecolors="none")  # fmt: skip
         ax2.add_collection(pc)
-        fig.colorbar(pc, ax=ax2, label="equivalent plastic strain")
+        fig.colorbar(pc, ax=ax2, label="equivalent plastic strain (cell mean)")
+    if bodies.block_block is None:
+        ax2.axhline(0.0, color="k", lw=1.5)  # the rigid wall
     reach = 2.0 * bodies.sizes.reach
     ax2.set_xlim(0.0, reach)
     ax2.set_ylim(-reach, reach)

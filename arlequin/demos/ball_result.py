@@ -35,7 +35,7 @@ RESULT_UNITS = {"contact_duration": "s", "peak_force": "N", "restitution": "1",
                 "hertz_peak_force": "N", "hertz_contact_duration": "s",
                 "hertz_indentation": "m", "hertz_contact_radius": "m", "fine_size": "m",
                 "coarse_size": "m", "n_steps": "1", "contact_radius_cells": "1",
-                "band_max_plastic_strain": "1"}  # fmt: skip
+                "band_max_plastic_strain": "1", "t_end": "s"}  # fmt: skip
 
 def hertz(radius: float, mass: float, velocity: float, ball: IsotropicElastic,
           block: IsotropicElastic | None) -> dict[str, float]:  # fmt: skip
@@ -71,8 +71,9 @@ class BallImpactResult(JsonResult):
     wall_time_s : float
         Wall time of the time loop (s).
     history : dict
-        Per sample (1000 over the run, :data:`~arlequin.demos.ball_record.SAMPLES`; every step
-        of a shorter run): ``t`` (s), ``contact_force``
+        Per sample (the first step after each t_end/1000: about 1000 rows,
+        :data:`~arlequin.demos.ball_record.SAMPLES`, or every step of a shorter run): ``t`` (s),
+        ``contact_force``
         (N), ``ball_velocity`` (m/s, along z), ``kinetic``, ``elastic`` (strain energy of the
         elastic models and stored energy of the J2 one), ``plastic_dissipation``,
         ``contact_work``, ``coupling_work`` (J).
@@ -83,6 +84,8 @@ class BallImpactResult(JsonResult):
     band_max_plastic_strain : float
         The largest ε̄p in the block patch's gluing band (1; the coarse model glued there is
         elastic: a warning above 0.02).
+    t_end : float
+        The simulated time (s): the given one, or the default the run chose.
     """
 
     contact_duration: float
@@ -101,6 +104,7 @@ class BallImpactResult(JsonResult):
     coarse_size: float = 0.0
     contact_radius_cells: float = 0.0
     band_max_plastic_strain: float = 0.0
+    t_end: float = 0.0
     config: dict[str, Any] = field(default_factory=dict)
 
     def to_json(self) -> dict[str, Any]:

@@ -23,15 +23,12 @@ The sudden onset of friction at the launch sends shear waves of traction amplitu
 the block; their velocity amplitude relative to v0 is r = μp/(ρ c_s v0), which sets how far the
 mean velocity wanders from the straight line, so the default pressure keeps r ≈ 1.2e-3.
 
-Those waves, and the ones the stop sends, make an undamped block vibrate in shear for ever with
-a base traction that reaches the Coulomb limit at the edges of the contact: the corners then
-slip by turns (micro-slip, measured up to 9.7e-4 v0 and over 38% of the steps after the stop,
-not decaying over 4 stop times; no creep of the block as a whole). A small material damping
-settles those vibrations and the block sticks for good, as a real one does: the demo uses
-stiffness-proportional Rayleigh damping with the ratio ``damping`` (default :data:`DAMPING`) at
-the block's first shear mode ω₁ = π c_s/(2H) (:class:`arlequin.integrators.RayleighDamping`);
-``damping=0`` gives the undamped elastic block. β damping leaves the rigid motion, and so the
-exact deceleration, untouched; the dissipated energy enters the balance.
+Those waves, and the stop's, make an undamped block vibrate in shear for ever, its base traction
+reaching the Coulomb limit at the contact's edges: the corners slip by turns (up to 9.7e-4 v0,
+38% of the steps after the stop, not decaying; no creep). Material damping settles them and the
+block sticks for good: stiffness-proportional damping (``RayleighDamping``), ratio ``damping``
+(default :data:`DAMPING`, 0: undamped) at the first shear mode ω₁ = π c_s/(2H). It leaves the
+rigid motion untouched; its work is in the balance.
 
 The step is 0.6 of the critical one (:data:`SAFETY`): friction feeds the normal force into the
 tangential one and lowers the stable step.
@@ -200,7 +197,10 @@ class SlidingBlockResult(JsonResult):
                 f"{self.expected_acceleration:.6e}), stop {stop}{exp}, sliding distance "
                 f"{self.sliding_distance:.3e} m, energy balance {self.energy_balance_error:.2e}, "
                 f"fixed point {self.fixed_point_iterations['mean']:.2f} iterations per step "
-                f"(max {self.fixed_point_iterations['max']})")  # fmt: skip
+                f"(max {self.fixed_point_iterations['max']}), damping ratio "
+                f"{self.config.get('damping')}" + (f"; the base still slips after the stop in "
+                f"{100 * self.slipping_steps_after_stop:.0f}% of the steps" if
+                self.slipping_steps_after_stop else ""))  # fmt: skip
 
 
 def _check(dim, friction, velocity, incline, pressure, gravity, elements, t_end, young, poisson,
