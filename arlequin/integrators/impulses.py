@@ -93,7 +93,12 @@ class ImpulseSolver:
 
             def build_schur():
                 s_aa = (g_a @ sp.diags(minv) @ g_a.T).tocsr()
-                x = self.lu.solve(s_ae.T.toarray()) if s_ae.nnz else np.zeros((self.m_e, m_a))
+                # only the active rows that share a dof with the equality rows have a non-zero
+                # column in (B M⁻¹ G_Aᵀ): solve for those alone (a few near a symmetry axis)
+                x = np.zeros((self.m_e, m_a))
+                coupled = np.nonzero(np.diff(s_ae.indptr))[0]
+                if coupled.size:
+                    x[:, coupled] = self.lu.solve(s_ae[coupled].T.toarray())
                 schur = s_aa.toarray() - s_ae @ x
                 try:
                     cho = sla.cho_factor(schur)
