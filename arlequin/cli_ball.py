@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from .cli_common import add_out, progress_bar, write_json
+from .cli_common import add_out, run_demo
 
 __all__ = ["add_ball_impact", "ball_options"]
 
@@ -47,10 +47,7 @@ def _cmd(args: argparse.Namespace) -> int:
 
     opts = ball_options(args)
     run_ball_impact(**opts, check_only=True)  # every input checked before the progress bar
-    with progress_bar(100.0, "%", args.quiet, scale=100.0, label="ball impact") as update:
-        result = run_ball_impact(out=args.out, progress=update, **opts)
-    print(result.summary())
-    write_json(args.json, result.to_json())
+    run_demo(run_ball_impact, opts, args, "ball impact")
     return 0
 
 

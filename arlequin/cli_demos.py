@@ -9,7 +9,7 @@ import argparse
 
 from .cli_ball import add_ball_impact
 from .cli_common import add_out as _add_out
-from .cli_common import progress_bar
+from .cli_common import run_demo
 from .cli_common import write_json as _write_json
 from .cli_sliding import add_sliding_block
 from .cli_taylor import add_taylor_bar
@@ -119,10 +119,7 @@ def _add_patch_test(sub) -> None:
 def _cmd_two_bars(args: argparse.Namespace) -> int:
     from .demos.two_bars import plot_two_bars, run_two_bars
 
-    with progress_bar(100.0, "%", args.quiet, scale=100.0, label="two bars") as update:
-        result = run_two_bars(out=args.out, progress=update, **two_bars_options(args))
-    print(result.summary())
-    _write_json(args.json, result.to_json())
+    result = run_demo(run_two_bars, two_bars_options(args), args, "two bars")
     if args.plot:
         plot_two_bars(result, args.plot)
     return 0
@@ -191,10 +188,7 @@ def wave_options(args: argparse.Namespace) -> dict:
 def _cmd_wave(args: argparse.Namespace) -> int:
     from .demos.wave import plot_wave, run_wave
 
-    with progress_bar(100.0, "%", args.quiet, scale=100.0, label="coupled run") as update:
-        result = run_wave(out=args.out, progress=update, **wave_options(args))
-    print(result.summary())
-    _write_json(args.json, result.to_json())
+    result = run_demo(run_wave, wave_options(args), args, "coupled run")
     if args.plot:
         plot_wave(result, args.plot)
     return 0

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from .cli_common import add_out, progress_bar, write_json
+from .cli_common import add_out, run_demo
 
 __all__ = ["add_sliding_block", "sliding_options"]
 
@@ -26,10 +26,7 @@ def sliding_options(args: argparse.Namespace) -> dict:
 def _cmd(args: argparse.Namespace) -> int:
     from .demos.sliding_block import run_sliding_block
 
-    with progress_bar(100.0, "%", args.quiet, scale=100.0, label="sliding block") as update:
-        result = run_sliding_block(out=args.out, progress=update, **sliding_options(args))
-    print(result.summary())
-    write_json(args.json, result.to_json())
+    run_demo(run_sliding_block, sliding_options(args), args, "sliding block")
     return 0
 
 
