@@ -179,7 +179,10 @@ class _ContactConstraint:
         cached = self._b_cache
         if cached is not None and cached[0] is g:  # the pair reuses unchanged rows
             return cached[1]
-        b = sp.csr_matrix(sp.diags(-self.pair.weights) @ g)
+        # −W G: each row scaled in place (a sparse product per step cost a tenth of a step)
+        b = sp.csr_matrix(g, copy=True)
+        b.data *= np.repeat(-self.pair.weights, np.diff(b.indptr))
+        b.eliminate_zeros()
         self._b_cache = (g, b)
         return b
 

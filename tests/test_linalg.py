@@ -38,3 +38,76 @@ def test_dependent_rows_are_refused():
     mat[:, 5] = mat[:, 4]  # rows 4 and 5 equal: singular
     with pytest.raises(ConstraintError, match="linearly dependent"):
         ScaledLU(mat.tocsr(), "test matrix", names=lambda i: f"row {i}", spd=True)
+
+
+def _fine_mediator_rows(n_coarse: int, ratio: int, seed: int = 0):
+    """Rows shaped like a nested 1D L2 fine-mediator coupling plus a few axis-like rows.
+
+    Row i (a fine node) touches the fine dofs i−1, i, i+1 (a mass-matrix stencil) and the two
+    coarse dofs of the coarse cell that holds it, each shared by about ``ratio`` rows; three
+    more rows touch one dof each that nothing else touches (a symmetry axis off the band).
+    """
+    rng = np.random.default_rng(seed)
+    n_fine = n_coarse * ratio + 1
+    rows, cols, vals = [], [], []
+    for i in range(n_fine):
+        for j in (i - 1, i, i + 1):
+            if 0 <= j < n_fine:
+                rows.append(i)
+                cols.append(j)
+                vals.append(4.0 if j == i else 1.0)
+        cell = min(i // ratio, n_coarse - 1)
+        for k in (cell, cell + 1):
+            rows.append(i)
+            cols.append(n_fine + k)
+            vals.append(-rng.uniform(1.0, 3.0))
+    n_dofs = n_fine + n_coarse + 1
+    for r in range(3):
+        rows.append(n_fine + r)
+        cols.append(n_dofs + r)
+        vals.append(1.0)
+    b = sp.csr_matrix((vals, (rows, cols)), shape=(n_fine + 3, n_dofs + 3))
+    inv_mass = rng.uniform(0.5, 2.0, n_dofs + 3)
+    return b, inv_mass
+
+
+def test_factor_rows_splits_isolated_rows_and_shared_dofs():
+    from arlequin.integrators.linalg import IsolatedRowsSolver, LowRankSplitSolver, factor_rows
+
+    b, inv_mass = _fine_mediator_rows(n_coarse=6, ratio=64)
+    s = (b @ sp.diags(inv_mass) @ b.T).toarray()
+    solver = factor_rows(b, inv_mass, "test rows")
+    # the three single-dof rows are divisions, the coarse dofs (shared by 64 rows) go to U
+    assert isinstance(solver, IsolatedRowsSolver)
+    assert solver.isolated.tolist() == [b.shape[0] - 3, b.shape[0] - 2, b.shape[0] - 1]
+    assert isinstance(solver.rest_solver, LowRankSplitSolver)
+    assert solver.rest_solver.n_heavy == 7
+    rng = np.random.default_rng(2)
+    for rhs in (rng.standard_normal(b.shape[0]), rng.standard_normal((b.shape[0], 4))):
+        # exact up to round-off: the dense solve of B M⁻¹ Bᵀ (condition number about 1e3)
+        assert np.allclose(solver.solve(rhs), np.linalg.solve(s, rhs), rtol=1e-10, atol=1e-12)
+    # a right-hand side on the isolated rows alone: x = r / S_ii there, zero elsewhere
+    rhs = np.zeros(b.shape[0])
+    rhs[-2] = 3.0
+    x = solver.solve(rhs)
+    assert x[-2] == 3.0 / s[-2, -2] and not np.any(x[:-2]) and x[-1] == 0.0
+
+
+def test_factor_rows_without_shared_dofs_is_one_lu():
+    from arlequin.integrators.linalg import factor_rows
+
+    b, inv_mass = _fine_mediator_rows(n_coarse=6, ratio=2)  # coarse dofs in 2-3 rows: light
+    solver = factor_rows(b[:-3], inv_mass, "test rows")
+    assert isinstance(solver, ScaledLU)
+    s = (b[:-3] @ sp.diags(inv_mass) @ b[:-3].T).toarray()
+    rhs = np.random.default_rng(3).standard_normal(s.shape[0])
+    assert np.allclose(solver.solve(rhs), np.linalg.solve(s, rhs), rtol=1e-12, atol=0)
+
+
+def test_factor_rows_names_dependent_rows():
+    from arlequin.integrators.linalg import factor_rows
+
+    b, inv_mass = _fine_mediator_rows(n_coarse=4, ratio=64)
+    b = sp.vstack([b, b[10]]).tocsr()  # row 10 twice: the split's A is singular, then S
+    with pytest.raises(ConstraintError, match="linearly dependent"):
+        factor_rows(b, inv_mass, "test rows", names=lambda i: f"row {i}")

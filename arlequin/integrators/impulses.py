@@ -12,7 +12,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 
 from ..contract import ConstraintError
-from .linalg import factor_checked
+from .linalg import factor_checked, factor_rows
 from .rows import rows_key
 
 __all__ = ["ImpulseSolver"]
@@ -21,7 +21,8 @@ __all__ = ["ImpulseSolver"]
 class ImpulseSolver:
     """Solves (B M⁻¹ Bᵀ) Λ = r for the equality rows E plus the active unilateral rows A.
 
-    The equality block S_EE is factorised once; active rows enter by a Schur complement
+    The equality block S_EE is factorised once (:func:`~arlequin.integrators.linalg.factor_rows`:
+    by a low-rank split under a fine mediator); active rows enter by a Schur complement
     (dense, cached for the last active rows, keyed by their content), or by a sparse
     factorisation of the whole matrix when there are many of them.
     """
@@ -33,20 +34,29 @@ class ImpulseSolver:
         self.inv_mass = inv_mass
         self.m_e = rows.m
         if self.m_e:
-            bj = rows.matrix_cols
-            s = (bj @ sp.diags(inv_mass[rows.cols]) @ bj.T).tocsc()
-            self.s_ee = s
-            self.lu = factor_checked(
-                s, "the impulse matrix B M⁻¹ Bᵀ of the equality rows", rows.row_name, spd=True
-            )
+            self.lu = factor_rows(
+                rows.matrix_cols, inv_mass[rows.cols],
+                "the impulse matrix B M⁻¹ Bᵀ of the equality rows", rows.row_name,
+            )  # fmt: skip
         else:
-            self.s_ee = None
             self.lu = None
+        self._s_ee: sp.csc_matrix | None = None
+        # Bᵀ of the equality rows, once (the Schur complement's S_AE = G_A M⁻¹ Bᵀ every step)
+        self._eq_t = rows.matrix.T.tocsr() if self.m_e else None
         self._cache: dict[Any, Any] = {}
         self._last_key: tuple[Any, bytes] | None = None
         self._eq_mask = np.zeros(inv_mass.size, dtype=bool)
         if self.m_e:
             self._eq_mask[rows.cols] = True
+
+    @property
+    def s_ee(self) -> sp.csc_matrix:
+        """B M⁻¹ Bᵀ of the equality rows (built on first use: it is dense by blocks under a
+        fine mediator)."""
+        if self._s_ee is None:
+            bj = self.rows.matrix_cols
+            self._s_ee = (bj @ sp.diags(self.inv_mass[self.rows.cols]) @ bj.T).tocsc()
+        return self._s_ee
 
     def solve_equality(self, r: np.ndarray) -> np.ndarray:
         """Λ_E (N·s per row unit) of the equality rows alone for the right-hand side r (m_E,)."""
@@ -74,32 +84,36 @@ class ImpulseSolver:
             return self.solve_equality(r_e), np.zeros(0)
         key = self._key(g_a)
         minv = self.inv_mass
+        # G_A M⁻¹ by scaling its entries (no diagonal matrix, no product): reused below
+        ga_m = g_a.copy()
+        ga_m.data = ga_m.data * minv[ga_m.indices]
         if self.m_e and not self._eq_mask[g_a.indices].any():
             # no dof shared with the equality rows (a wall and a symmetry axis): two blocks
             def build_aa_only():
-                s_aa = (g_a @ sp.diags(minv) @ g_a.T).tocsr()
+                s_aa = (ga_m @ g_a.T).tocsr()
                 return factor_checked(s_aa, "the impulse matrix of the active rows", spd=True)
 
             return self.solve_equality(r_e), self._cached(key, build_aa_only).solve(r_a)
         if self.m_e == 0:
 
             def build_aa():
-                s_aa = (g_a @ sp.diags(minv) @ g_a.T).tocsr()
+                s_aa = (ga_m @ g_a.T).tocsr()
                 return factor_checked(s_aa, "the impulse matrix of the active rows", spd=True)
 
             return np.zeros(0), self._cached(key, build_aa).solve(r_a)
-        s_ae = (g_a @ sp.diags(minv) @ self.rows.matrix.T).tocsr()
+        s_ae = (ga_m @ self._eq_t).tocsr()
         if m_a <= self._DENSE_SCHUR:
 
             def build_schur():
-                s_aa = (g_a @ sp.diags(minv) @ g_a.T).tocsr()
+                s_aa = (ga_m @ g_a.T).tocsr()
                 # only the active rows that share a dof with the equality rows have a non-zero
                 # column in (B M⁻¹ G_Aᵀ): solve for those alone (a few near a symmetry axis)
-                x = np.zeros((self.m_e, m_a))
                 coupled = np.nonzero(np.diff(s_ae.indptr))[0]
+                x = self.lu.solve(s_ae[coupled].T.toarray()) if coupled.size else \
+                    np.zeros((self.m_e, 0))  # fmt: skip
+                schur = s_aa.toarray()
                 if coupled.size:
-                    x[:, coupled] = self.lu.solve(s_ae[coupled].T.toarray())
-                schur = s_aa.toarray() - s_ae @ x
+                    schur[:, coupled] -= s_ae @ x
                 try:
                     cho = sla.cho_factor(schur)
                 except np.linalg.LinAlgError as exc:
@@ -107,15 +121,17 @@ class ImpulseSolver:
                         "active unilateral rows are dependent on each other or on the equality "
                         f"rows ({m_a} active rows)"
                     ) from exc
-                return x, cho
+                return coupled, x, cho
 
-            x, cho = self._cached(key, build_schur)
+            coupled, x, cho = self._cached(key, build_schur)
             y = self.lu.solve(r_e)
             lam_a = sla.cho_solve(cho, r_a - s_ae @ y)
-            return y - x @ lam_a, lam_a
+            if coupled.size:
+                y = y - x @ lam_a[coupled]
+            return y, lam_a
 
         def build_full():
-            s_aa = (g_a @ sp.diags(minv) @ g_a.T).tocsr()
+            s_aa = (ga_m @ g_a.T).tocsr()
             full = sp.bmat([[self.s_ee, s_ae.T], [s_ae, s_aa]], format="csc")
             return factor_checked(full, "the impulse matrix with the active rows", spd=True)
 

@@ -3,6 +3,8 @@
 The matrices mix rows of very different units (stiffness N/m, mass kg, constraint rows of m² for
 L2 coupling): :class:`ScaledLU` scales them symmetrically before SuperLU and turns (numerical)
 singularity into a :class:`~arlequin.contract.ConstraintError` that names the offending row.
+:func:`factor_rows` factorises the impulse matrix B M⁻¹ Bᵀ of constraint rows, by
+:class:`LowRankSplitSolver` when a few dofs shared by many rows make it dense.
 """
 
 from __future__ import annotations
@@ -10,12 +12,13 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
+import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..contract import ConstraintError
 
-__all__ = ["ScaledLU", "factor_checked"]
+__all__ = ["IsolatedRowsSolver", "LowRankSplitSolver", "ScaledLU", "factor_checked", "factor_rows"]
 
 
 class ScaledLU:
@@ -120,3 +123,165 @@ def factor_checked(
     if mat.shape[0] == 0:
         return None
     return ScaledLU(mat, what, names, spd)
+
+
+class LowRankSplitSolver:
+    """Solves (B M⁻¹ Bᵀ) x = r by splitting B's columns: S = A + U Uᵀ (Woodbury).
+
+    A fine-mediator L2 coupling has rows that each touch a few fine dofs and the coarse dofs
+    of the coarse cell below: a coarse dof is shared by every row in its cells (about
+    2·(2^levels + 1)² of them), so S = B M⁻¹ Bᵀ is nearly dense by blocks (a band of 7,600 rows
+    at three levels: 480 entries a row, a SuperLU solve of 2.8 ms). With B = [B_L, B_H], the
+    heavy columns H (the shared dofs, few) and the light ones L, A = B_L M_L⁻¹ B_Lᵀ stays as
+    sparse as the fine mesh and U = B_H M_H^{-1/2} has a few columns, so
+
+        S⁻¹ r = A⁻¹ r − A⁻¹ U K⁻¹ Uᵀ A⁻¹ r,    K = I + Uᵀ A⁻¹ U (dense, SPD, ≥ I),
+
+    one sparse solve of A, a product with Uᵀ, a dense Cholesky solve of size |H| and a product
+    with W = A⁻¹ U (stored, shape (m, |H|)), or a second sparse solve when that is cheaper.
+
+    Parameters
+    ----------
+    b : sparse, shape (m, n)
+        The rows (on the dofs they touch).
+    inv_mass : ndarray, shape (n,)
+        M⁻¹ on those dofs (1/kg).
+    heavy : ndarray of bool, shape (n,)
+        The columns put in U.
+    what : str
+        Name of the matrix, for errors.
+
+    Raises
+    ------
+    ConstraintError
+        If A is singular (rows dependent on their light columns): the caller falls back to
+        one factorisation of S.
+    """
+
+    def __init__(self, b: sp.csr_matrix, inv_mass: np.ndarray, heavy: np.ndarray,
+                 what: str) -> None:  # fmt: skip
+        b = sp.csc_matrix(b)
+        light = np.nonzero(~heavy)[0]
+        heavy_cols = np.nonzero(heavy)[0]
+        b_l = b[:, light]
+        a = (b_l @ sp.diags(inv_mass[light]) @ b_l.T).tocsc()
+        self.a = ScaledLU(a, what, spd=True)
+        self.u = sp.csr_matrix(b[:, heavy_cols] @ sp.diags(np.sqrt(inv_mass[heavy_cols])))
+        self.shape = (b.shape[0], b.shape[0])
+        w = self.a.solve(self.u.toarray())
+        k = np.eye(heavy_cols.size) + self.u.T @ w
+        self.cho = sla.cho_factor(k)
+        lu = getattr(self.a, "lu", None)
+        fill = (lu.L.nnz + lu.U.nnz) if lu is not None else b.shape[0]
+        # a dense product with W costs about a quarter of a SuperLU solve per entry (measured)
+        self.w = w if w.size <= 4 * fill else None
+        self.n_heavy = int(heavy_cols.size)
+
+    def solve(self, rhs: np.ndarray) -> np.ndarray:
+        """Solve S x = rhs; rhs of shape (m,) or (m, k)."""
+        y = self.a.solve(rhs)
+        z = sla.cho_solve(self.cho, self.u.T @ y)
+        if self.w is not None:
+            return y - self.w @ z
+        return y - self.a.solve(self.u @ z)
+
+
+class IsolatedRowsSolver:
+    """Solves (B M⁻¹ Bᵀ) x = r when some rows share no dof with any other row.
+
+    Those rows (a symmetry axis or a support away from a coupling band) are one division
+    each; the others go to ``rest``. A right-hand side that is zero on the other rows (the
+    contact rows coupled to the axis at the contact point) costs no solve at all.
+
+    Parameters
+    ----------
+    isolated : ndarray of int
+        The isolated rows.
+    diagonal : ndarray, shape (len(isolated),)
+        Their diagonal entries Σ_j B_ij² M⁻¹_j.
+    rest : ndarray of int
+        The other rows.
+    rest_solver : object with ``solve``, or None
+        Their factorisation.
+    """
+
+    def __init__(self, isolated: np.ndarray, diagonal: np.ndarray, rest: np.ndarray,
+                 rest_solver) -> None:  # fmt: skip
+        self.isolated, self.rest = isolated, rest
+        self.inv_diag = 1.0 / diagonal
+        self.rest_solver = rest_solver
+        m = isolated.size + rest.size
+        self.shape = (m, m)
+
+    def solve(self, rhs: np.ndarray) -> np.ndarray:
+        """Solve S x = rhs; rhs of shape (m,) or (m, k)."""
+        x = np.zeros_like(rhs, dtype=float)
+        inv = self.inv_diag if rhs.ndim == 1 else self.inv_diag[:, None]
+        x[self.isolated] = inv * rhs[self.isolated]
+        part = rhs[self.rest]
+        if self.rest.size and np.any(part):
+            x[self.rest] = self.rest_solver.solve(part)
+        return x
+
+
+#: Columns shared by more rows than this (and than 4× the median) are candidates for U.
+_HEAVY_COLUMN = 32
+
+
+def factor_rows(
+    b: sp.spmatrix, inv_mass: np.ndarray, what: str, names: Callable[[int], str] | None = None
+) -> ScaledLU | LowRankSplitSolver | IsolatedRowsSolver | None:
+    """Factorisation of the impulse matrix B M⁻¹ Bᵀ of constraint rows (None if no rows).
+
+    Rows sharing no dof with another row are split off (:class:`IsolatedRowsSolver`);
+    :class:`LowRankSplitSolver` when a few columns shared by many rows (at most a fifth of the
+    rows, each row keeping a column of its own) make the matrix at least 4× denser than
+    without them; one :class:`ScaledLU` otherwise, or if the split's A is singular (then the
+    whole matrix's factorisation names the dependent rows).
+
+    Parameters
+    ----------
+    b : sparse, shape (m, n)
+        The rows on the dofs they touch.
+    inv_mass : ndarray, shape (n,)
+        M⁻¹ on those dofs (1/kg).
+    what, names
+        As for :class:`ScaledLU`.
+    """
+    b = sp.csr_matrix(b)
+    b.eliminate_zeros()
+    m = b.shape[0]
+    if m == 0:
+        return None
+    pattern = b.copy()
+    pattern.data = np.ones_like(pattern.data)
+    counts = np.asarray(pattern.sum(axis=0)).ravel()
+    # rows whose dofs no other row touches: diagonal (a non-empty row only)
+    shared = pattern @ (counts > 1).astype(float)
+    isolated = np.nonzero((shared == 0) & (np.diff(b.indptr) > 0))[0]
+    if 0 < isolated.size < m:
+        rest = np.setdiff1d(np.arange(m), isolated)
+        diag = np.asarray(b[isolated].multiply(b[isolated]) @ inv_mass).ravel()
+        sub_names = None if names is None else (lambda i: names(int(rest[i])))
+        return IsolatedRowsSolver(isolated, diag, rest,
+                                  factor_rows(b[rest], inv_mass, what, sub_names))  # fmt: skip
+    used = counts[counts > 0]
+    heavy = counts > max(_HEAVY_COLUMN, 4.0 * (np.median(used) if used.size else 0.0))
+    if heavy.any():
+        # a row with only heavy columns would leave A singular: its columns stay light
+        light_per_row = pattern @ (~heavy).astype(float)
+        lonely = np.nonzero(light_per_row == 0)[0]
+        if lonely.size:
+            heavy[pattern[lonely].indices] = False
+    n_heavy = int(heavy.sum())
+    if 0 < n_heavy <= m // 5:
+        light = pattern[:, np.nonzero(~heavy)[0]]
+        nnz_a = (light @ light.T).nnz
+        nnz_s = (pattern @ pattern.T).nnz
+        if nnz_s >= 4 * nnz_a:
+            try:
+                return LowRankSplitSolver(b, inv_mass, heavy, what)
+            except (ConstraintError, np.linalg.LinAlgError):
+                pass
+    s = (b @ sp.diags(inv_mass) @ b.T).tocsc()
+    return ScaledLU(s, what, names, spd=True)
