@@ -4,17 +4,21 @@ tutorial of docs/ball_impact.md).
 Two bodies in one problem (:class:`arlequin.MultiBodyProblem`), each a coarse linear-elastic
 model of the whole body plus a refined patch at the contact point (nested, its boundary nodes on
 the sphere for the ball), glued by the fine mediator in a band at the patch's edge; the
-level-set contact between the two patches. This is what
-``arlequin.demos.run_ball_impact(coarse_size=..., fine_size=...)`` builds (the test suite
-checks that both give the same run). ``run(**params) -> dict``; ``python
-examples/ball_on_block.py`` prints the peak force and contact duration against Hertz's (about
-25 s). Axisymmetric (r, z); SI units.
+level-set contact between the two patches. With ``plastic=True`` the block is copper and its
+patch, larger (0.8 R: the plastic zone), carries finite-strain J2 plasticity while its coarse
+model stays elastic. This is what ``arlequin.demos.run_ball_impact(coarse_size=...,
+fine_size=...)`` builds (``regime="plastic"`` for the second; the test suite checks that both
+give the same runs). ``run(**params) -> dict``; ``python examples/ball_on_block.py`` prints the
+peak force and contact duration against Hertz's (about 25 s), ``python
+examples/ball_on_block.py plastic`` the plastic impact's dent and restitution. Axisymmetric
+(r, z); SI units.
 """
 
 from __future__ import annotations
 
 import json
 import math
+import sys
 
 import numpy as np
 import skfem
@@ -24,7 +28,9 @@ from arlequin.integrators import solve
 from arlequin.models import (
     ContactSurface,
     DeformableContactPair,
+    FiniteStrainJ2,
     IsotropicElastic,
+    J2Material,
     LevelSetContact,
     LinearElastic,
 )
@@ -64,24 +70,33 @@ def ball_mesh(radius: float, n: int) -> skfem.MeshQuad:
     return skfem.MeshQuad(np.ascontiguousarray(p), np.ascontiguousarray(inverse.ravel()[t]))
 
 
-def run(n: int = 20, levels: int = 2, velocity: float = 1.0, block_size: float = 0.1) -> dict:
+def run(n: int = 20, levels: int = 2, velocity: float | None = None,
+        block_size: float | None = None, plastic: bool = False) -> dict:
     """Peak contact force (N) and contact duration (s) of a steel ball (R = 10 mm) striking a
-    steel block (radius = height = ``block_size``) at ``velocity`` (m/s), with Hertz's values;
-    ``n``: the ball's O-grid at the coarse size π R/(4 n), ``levels``: the patches' refinements."""
+    block (radius = height = ``block_size``, default 10 R, or 2 R when plastic) at ``velocity``
+    (m/s, default 1, or 10 when plastic), with Hertz's values (the elastic steel block) or the
+    dent depth (m) and the maximum ε̄p (the copper J2 block); ``n``: the ball's O-grid at the
+    coarse size π R/(4 n), ``levels``: the patches' refinements."""
     R = 0.01
     steel = IsotropicElastic(210e9, 0.3, 7850.0)
+    # the plastic block: the Taylor bar's copper, σ_y = 0.4 GPa, linear hardening 0.1 GPa
+    copper = J2Material(117e9, 0.35, 8930.0, yield_stress=0.4e9, hardening_modulus=0.1e9)
+    velocity = (10.0 if plastic else 1.0) if velocity is None else velocity
+    block_size = (2 * R if plastic else 10 * R) if block_size is None else block_size
     h_c = 0.25 * math.pi * R / n  # coarse size along the ball's arc
-    reach, band = 0.2 * R, 2 * h_c  # the patches' radius and gluing band
+    reach, band = (0.4 if plastic else 0.2) * R, 2 * h_c  # the patches' radius, gluing band
+    # the block's patch covers the plastic zone, which reaches beyond the contact radius
+    block_reach = min(0.8 * R, 0.5 * block_size) if plastic else reach
     zone = reach - band - h_c  # the contact surfaces: inside the patches, below the bands
     tol = 1e-9 * R
 
     # 1. the ball: a coarse model of it all, a patch refining the coarse cells near the pole,
     #    its new boundary nodes moved onto the sphere (within the sagitta of a coarse facet)
-    def near_pole(x):
-        return np.hypot(x[0], x[1]) - reach  # < 0 within the patches' radius
+    def within(radius):
+        return lambda x: np.hypot(x[0], x[1]) - radius  # < 0 within radius of the contact point
 
     ball_coarse = ball_mesh(R, n)
-    ball_patch = arlequin.refine_region(ball_coarse, levels, level_set=near_pole)
+    ball_patch = arlequin.refine_region(ball_coarse, levels, level_set=within(reach))
     p = ball_patch.p.copy()
     d = np.hypot(p[0], p[1] - R)
     edge = np.unique(ball_patch.facets[:, ball_patch.boundary_facets()])
@@ -92,18 +107,23 @@ def run(n: int = 20, levels: int = 2, velocity: float = 1.0, block_size: float =
 
     # 2. the block: a tensor grid graded away from the contact point, the same kind of patch
     # cells of h_c over the patch, then growing by 15%, the last node on the block's edge
-    growth, n_u = 1.15, math.ceil(reach / h_c - 1e-9)
+    growth, n_u = 1.15, math.ceil(block_reach / h_c - 1e-9)
     start = n_u * h_c
     k = round(math.log1p((block_size - start) * (growth - 1) / h_c) / math.log(growth))
     x = np.concatenate([[0.0], np.cumsum(h_c * growth ** np.arange(k))])
     r = np.concatenate([h_c * np.arange(n_u), start + x * ((block_size - start) / x[-1])])
     block_coarse = skfem.MeshQuad.init_tensor(r, np.concatenate([-r[::-1][:-1], [0.0]]))
-    block_patch = arlequin.refine_region(block_coarse, levels, level_set=near_pole)
+    block_patch = arlequin.refine_region(block_coarse, levels, level_set=within(block_reach))
 
-    # 3. each body an Arlequin problem: coarse elastic model, fine patch, u_r = 0 on the axis
-    def body(coarse_mesh, patch_mesh):
-        coarse = LinearElastic(coarse_mesh, steel, kind="axisymmetric")
-        fine = LinearElastic(patch_mesh, steel, kind="axisymmetric")
+    # 3. each body an Arlequin problem: coarse elastic model, fine patch (elastic, or J2 with
+    #    F-bar for the copper block: its coarse model keeps the elastic part), u_r = 0 on the axis
+    def body(coarse_mesh, patch_mesh, material):
+        if isinstance(material, J2Material):
+            coarse = LinearElastic(coarse_mesh, material.elastic, kind="axisymmetric")
+            fine = FiniteStrainJ2(patch_mesh, material, "axisymmetric", fbar=True)
+        else:
+            coarse = LinearElastic(coarse_mesh, material, kind="axisymmetric")
+            fine = LinearElastic(patch_mesh, material, kind="axisymmetric")
         patch = arlequin.Patch(fine, gluing_width=band, coupling="L2", mediator="fine",
                                overlap_method="nested", name="patch")  # fmt: skip
         problem = arlequin.ArlequinProblem(coarse, [patch], mediator_dirichlet="drop")
@@ -111,7 +131,8 @@ def run(n: int = 20, levels: int = 2, velocity: float = 1.0, block_size: float =
             problem.add_dirichlet(block, lambda x: x[0] < tol, components=[0])
         return problem
 
-    ball, block = body(ball_coarse, ball_patch), body(block_coarse, block_patch)
+    ball = body(ball_coarse, ball_patch, steel)
+    block = body(block_coarse, block_patch, copper if plastic else steel)
     block.add_dirichlet("coarse", lambda x: x[1] < -block_size + tol, components=[1])  # rollers
 
     # 4. both bodies in one system; the contact between the patches on its dof map
@@ -145,15 +166,28 @@ def run(n: int = 20, levels: int = 2, velocity: float = 1.0, block_size: float =
         force.append((integ.t, 0.0 if lam is None else float(-(lam * pair.weights).sum())))
 
     t_end = 1.4 * hertz_duration
+    if plastic:
+        # a fully plastic contact (mean pressure 3 σ_y over π a², a² = 2 R δ) is a spring
+        # k = 6π R σ_y: its half period π √(m/k) loads, 1.5 × it covers the unloading too
+        t_end = 1.5 * math.pi * math.sqrt(mass.sum() / (6 * math.pi * R * copper.yield_stress))
     res = solve(system, "explicit", t_end=t_end, v0=v0, constraints=[contact], on_step=[record],
                 t_eval=np.linspace(0.0, t_end, 11)[1:])  # fmt: skip
     t, f = np.array(force).T
     duration = float(t[f > 0.0][-1])
-    return {"peak_force": float(f.max()), "contact_duration": duration,
-            "hertz_peak_force": hertz_force, "hertz_contact_duration": hertz_duration,
-            "rebound_velocity": float(mass @ res.v[ball_z] / mass.sum()),
-            "n_steps": int(res.n_steps)}  # fmt: skip
+    out = {"peak_force": float(f.max()), "contact_duration": duration,
+           "rebound_velocity": float(mass @ res.v[ball_z] / mass.sum()),
+           "n_steps": int(res.n_steps)}  # fmt: skip
+    if not plastic:
+        out.update(hertz_peak_force=hertz_force, hertz_contact_duration=hertz_duration)
+        return out
+    # 7. the dent (the block's top point on the axis) and the patch's plastic strain
+    pole = int(np.nonzero((block_patch.p[0] < tol) & (block_patch.p[1] > -tol))[0][0])
+    state = res.states["block.patch"][0]
+    out.update(dent_depth=float(-res.u[dm["block.patch"].offset + 2 * pole + 1]),
+               restitution=out["rebound_velocity"] / velocity,
+               max_plastic_strain=float(state.eqps.max()))
+    return out
 
 
 if __name__ == "__main__":
-    print(json.dumps(run(), indent=2))
+    print(json.dumps(run(plastic=len(sys.argv) > 1 and sys.argv[1] == "plastic"), indent=2))

@@ -367,6 +367,29 @@ class FiniteStrainJ2:
         psi = 0.5 * K * tr**2 + G * np.sum(dev**2, axis=0)
         return float(np.sum(alpha * self.kin.dv0 * psi))
 
+    def stored_energy_of_state(self, state: PlasticState, weight: WeightLike = None) -> float:
+        """Elastic stored energy Σ w₀ ψ (J) from a state's own Kirchhoff stress: for the Hencky
+        law τ = K ln J 1 + 2G dev ε_e, so ψ = (tr τ)²/(18 K) + |dev τ|²/(4 G).
+
+        The same as :meth:`stored_energy` at the displacement the state was evaluated at (to
+        round-off), without recomputing the kinematics: a product per quadrature point.
+
+        Raises
+        ------
+        ValueError
+            With bulk viscosity, whose pressure the state's τ includes.
+        """
+        if self.bulk_viscosity:
+            raise ValueError("stored_energy_of_state: the state's Kirchhoff stress includes the "
+                             "bulk viscosity's pressure; use stored_energy(u, state)")  # fmt: skip
+        alpha = self.elastic.weight_at_quadrature(weight)
+        tau = state.kirchhoff
+        tr = tau[0, 0] + tau[1, 1] + tau[2, 2]
+        dev2 = np.einsum("ij...,ij...->...", tau, tau) - tr**2 / 3.0
+        K, G = self.material.bulk_modulus, self.material.shear_modulus
+        psi = tr**2 / (18.0 * K) + dev2 / (4.0 * G)
+        return float(np.sum(alpha * self.kin.dv0 * psi))
+
     def plastic_dissipation(self, state: PlasticState, weight: WeightLike = None) -> float:
         """Accumulated plastic work Σ w₀ w_p (J)."""
         alpha = self.elastic.weight_at_quadrature(weight)

@@ -167,9 +167,11 @@ def test_ball_on_the_elastic_block_against_hertz(tmp_path):
         assert (tmp_path / "run" / name).stat().st_size > 0
     keys = list(r.to_json())
     assert keys[: len(JSON_KEYS)] == list(JSON_KEYS)
+    # the Interface's history keys, and the friction work (0 without friction)
     assert set(r.to_json()["history"]) == {"t", "contact_force", "ball_velocity", "kinetic",
                                            "elastic", "plastic_dissipation", "contact_work",
-                                           "coupling_work"}  # fmt: skip
+                                           "coupling_work", "friction_work"}  # fmt: skip
+    assert not any(r.history["friction_work"])
 
 
 def test_bad_input_is_refused_before_any_work():
@@ -269,3 +271,35 @@ def test_plastic_regime_against_the_uniform_mesh(plastic_runs):
     assert arl.band_max_plastic_strain == 0.0
     assert max(arl.energy_balance_error, mono.energy_balance_error) < 0.01
     assert 0.0 < arl.patch_fraction <= 0.1
+
+
+def test_a_contact_reaching_the_edge_of_the_contact_surfaces_stops_the_run(tmp_path):
+    # coarse π R/40 leaves a contact zone of patch_size − 3 coarse cells = 1.6 mm on the ball,
+    # below the 1.9 mm the plastic contact reaches (patch_size 0.49 R gives it, and then peak
+    # force and dent within 0.5% of mono): the run stops at the edge instead of letting the
+    # bodies interpenetrate beyond it, and its folder says it failed
+    with pytest.raises(ValueError, match="edge of the contact surfaces"):
+        run_ball_impact(regime="plastic", block_radius=0.02, block_height=0.02,
+                        coarse_size=0.25 * math.pi * R / 10, fine_size=0.25 * math.pi * R / 40,
+                        out=tmp_path / "run")  # fmt: skip
+    status = json.loads((tmp_path / "run" / "results.json").read_text())
+    assert status["status"] == "failed" and "edge" in status["message"]
+
+
+@pytest.mark.slow
+def test_plastic_regime_with_friction_against_the_uniform_mesh():
+    # μ = 0.3 between the ball and the copper block, the set-up of plastic_runs. Measured
+    # (benchmarks/ball_impact.py --friction 0.3, same set-up): Arlequin against mono peak
+    # +0.50%, duration −0.05%, restitution +0.01%, dent +0.11%; friction against the
+    # frictionless mono: peak +0.9%, restitution +2.0%, dent +1.4%, max ε̄p 0.164 against 0.185
+    common = dict(regime="plastic", block_radius=0.02, block_height=0.02,
+                  coarse_size=0.25 * math.pi * R / 20, friction=0.3)  # fmt: skip
+    arl, mono = (run_ball_impact(model=m, **common) for m in ("arlequin", "mono"))
+    for key in ("peak_force", "restitution", "dent_depth", "contact_duration"):
+        assert getattr(arl, key) == pytest.approx(getattr(mono, key), rel=0.02)
+    for r in (arl, mono):
+        work = np.asarray(r.history["friction_work"])
+        assert work[-1] < 0.0 and np.all(np.diff(work) <= 1e-12 * r.history["kinetic"][0])
+        assert r.energy_balance_error < 0.01
+    # friction restrains the surface's radial flow: less plastic strain than without it (0.185)
+    assert arl.max_plastic_strain < 0.175

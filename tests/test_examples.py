@@ -75,3 +75,20 @@ def test_ball_on_block_tutorial_is_the_demo():
     assert out["peak_force"] == pytest.approx(demo.peak_force, rel=1e-12)
     assert out["contact_duration"] == demo.contact_duration
     assert out["hertz_peak_force"] == pytest.approx(demo.hertz["hertz_peak_force"], rel=1e-12)
+
+
+def test_ball_on_block_tutorial_plastic_patch_is_the_demo():
+    # the copper block's J2 patch built with the public API: the demo's plastic regime at the
+    # same sizes (R_B = H_B = 2 R), without multi-time-step (the tutorial has one step)
+    import math
+
+    from arlequin.demos.ball_impact import run_ball_impact
+
+    out = load("ball_on_block").run(n=20, levels=1, plastic=True)
+    h_c = 0.25 * math.pi * 0.01 / 20
+    demo = run_ball_impact(regime="plastic", block_radius=0.02, block_height=0.02,
+                           coarse_size=h_c, fine_size=h_c / 2, coarse_step_ratio=1)  # fmt: skip
+    assert out["n_steps"] == demo.n_steps
+    for key in ("peak_force", "dent_depth", "restitution", "max_plastic_strain"):
+        assert out[key] == pytest.approx(getattr(demo, key), rel=1e-10), key
+    assert out["contact_duration"] == demo.contact_duration

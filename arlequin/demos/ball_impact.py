@@ -32,7 +32,8 @@ block's top point on the axis, after the run), the maximum equivalent plastic st
 balance of the integrator (kinetic + strain − works of the contact, coupling and supports,
 against the largest energy).
 
-Multi-time-step is not the default yet (``coarse_step_ratio=1``).
+Multi-time-step is the default of the ``arlequin`` model (``coarse_step_ratio=None``: the coarse
+models' forces once every m ≤ 2^levels steps, the coarse-to-fine size ratio; 1 turns it off).
 
 Outputs (``out``): results.json (inputs and results with units), impact.csv (per step),
 history.csv and fields/*.xdmf (energies and fields per record, ParaView), ball_impact.png.
@@ -108,7 +109,7 @@ def run_ball_impact(
     coarse_size: float | None = None,
     friction: float = 0.0,
     rigid_wall: bool = False,
-    coarse_step_ratio: int = 1,
+    coarse_step_ratio: int | None = None,
     t_end: float | None = None,
     out: str | Path | None = None,
     progress: Callable[[float], None] | None = None,
@@ -144,10 +145,12 @@ def run_ball_impact(
         Coulomb coefficient μ between the bodies (0: frictionless).
     rigid_wall : bool
         The ball against the rigid plane z = 0 (no block).
-    coarse_step_ratio : int
-        1 (default): one step for every model. M > 1: the coarse models' forces once every
-        m ≤ M steps (``"explicit-mts"``, :class:`~arlequin.integrators.SubcycledCentralDifference`
-        with its resonance bound off and a 1% energy check), Arlequin only.
+    coarse_step_ratio : int, optional
+        M > 1: the coarse models' forces once every m ≤ M steps, the largest m that keeps them
+        stable (``"explicit-mts"``, :class:`~arlequin.integrators.SubcycledCentralDifference`
+        with its resonance bound off and a 1% energy check), Arlequin only. 1: one step for
+        every model. Default: 2^levels (the coarse size over the fine one) for ``arlequin``,
+        1 for the single-mesh models.
     t_end : float, optional
         Simulated time (s); default 1.4 × Hertz's duration (elastic) or 1.5 π √(m/k) with
         k = 6π R σ_y, the stiffness of a fully plastic contact at a mean pressure 3 σ_y
@@ -189,10 +192,11 @@ def run_ball_impact(
                          "yielding: give one of them")  # fmt: skip
     if not (math.isfinite(friction) and friction >= 0.0):
         raise ValueError(f"friction must be a non-negative number, got friction={friction}")
-    if isinstance(coarse_step_ratio, bool) or int(coarse_step_ratio) != coarse_step_ratio or \
-            coarse_step_ratio < 1:
+    if coarse_step_ratio is not None and (
+            isinstance(coarse_step_ratio, bool) or not isinstance(coarse_step_ratio, (int, float))
+            or int(coarse_step_ratio) != coarse_step_ratio or coarse_step_ratio < 1):
         raise ValueError(f"coarse_step_ratio must be a positive integer, got {coarse_step_ratio!r}")
-    if coarse_step_ratio > 1 and model != "arlequin":
+    if coarse_step_ratio is not None and coarse_step_ratio > 1 and model != "arlequin":
         raise ValueError("coarse_step_ratio > 1 needs the arlequin model (coarse models)")
     coarse = ARC_COARSE * big if coarse_size is None else _positive("coarse_size", coarse_size)
     if fine_size is not None:
@@ -224,6 +228,8 @@ def run_ball_impact(
         raise ValueError(f"block_patch_size={block_reach:.4g} m must lie between patch_size="
                          f"{reach:.4g} m and 0.9 of the block's size")  # fmt: skip
     sizes = ball_sizes(big, coarse, fine, reach, block_reach)
+    if coarse_step_ratio is None:
+        coarse_step_ratio = 2**sizes.levels if model == "arlequin" else 1
     # the patches' cells, about: their half discs at the fine size (the block's too)
     patch_cells = 0.5 * math.pi * (reach**2 + (0.0 if rigid_wall else block_reach**2)) \
         / sizes.fine**2

@@ -51,13 +51,26 @@ class ImpactRecorder:
         part = bodies.plastic_part()
         self._j2_block = None if part is None else part[1]
         self._e0: float | None = None
+        # the outermost contact point: once it touches, the contact would spread beyond the
+        # contact surfaces (the patches' zone inside their gluing bands) unseen
+        self._edge = float(bodies.slave_r.max()) * (1.0 - 1e-9)
+        self.macro_ratios: list[int] | None = None
 
     def __call__(self, integ) -> None:
         b = self.bodies
+        self.macro_ratios = getattr(integ, "ratios", None)  # multi-time-step's m per macro step
         st = integ.constraint_states.get("contact")
         active = getattr(st, "active", None)
         if active is not None and np.any(active):
             self.contact_radius = max(self.contact_radius, float(b.slave_r[active].max()))
+            if self.contact_radius >= self._edge:
+                raise ValueError(
+                    f"the contact reached the edge of the contact surfaces (radius "
+                    f"{self.contact_radius:.4g} m, the outermost point, at t = {integ.t:.4g} s): "
+                    f"the contact area would grow beyond them unseen (the bodies "
+                    f"interpenetrating there); "
+                    f"give a larger patch_size (now {b.sizes.reach:.4g} m: the zone is "
+                    f"patch_size − 3 coarse cells) or a smaller coarse_size")  # fmt: skip
         force = b.contact_force(integ.multipliers)
         self.times.append(integ.t)
         self.forces.append(force)
@@ -89,7 +102,8 @@ class ImpactRecorder:
                "ball_velocity": b.ball_velocity(integ.v), "kinetic": kinetic,
                "elastic": elastic, "plastic_dissipation": plastic,
                "contact_work": float(getattr(st, "work", 0.0)),
-               "coupling_work": float(sum(e["coupling_work"].values()))}  # fmt: skip
+               "coupling_work": float(sum(e["coupling_work"].values())),
+               "friction_work": float(getattr(st, "friction_work", 0.0))}  # fmt: skip
         for k in HISTORY_KEYS:
             self.rows[k].append(float(row[k]))
         if self.csv is not None:
@@ -113,7 +127,7 @@ class ImpactRecorder:
             max_eqps = float(np.max(eqps))
             if b.band_cells.size:
                 band_eqps = float(np.max(eqps[b.band_cells]))
-        v0 = -self.rows["ball_velocity"][0] if t.size else 0.0
+        v0 = float(config.get("velocity", 0.0))  # the impact velocity, before any contact
         scale = max(self.scale, 1e-300)
         return BallImpactResult(
             contact_duration=duration, peak_force=float(force.max()) if force.size else 0.0,
@@ -125,6 +139,8 @@ class ImpactRecorder:
             n_steps=int(res.n_steps), fine_size=b.sizes.fine, coarse_size=b.sizes.coarse,
             contact_radius_cells=self.contact_radius / b.sizes.fine,
             band_max_plastic_strain=band_eqps, config=dict(config),
+            coarse_step_ratio=int(config.get("coarse_step_ratio", 1)),
+            mean_step_ratio=float(np.mean(self.macro_ratios)) if self.macro_ratios else 1.0,
         )  # fmt: skip
 
 

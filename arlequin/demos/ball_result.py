@@ -20,10 +20,11 @@ JSON_KEYS = ("contact_duration", "peak_force", "restitution", "dent_depth",
              "max_plastic_strain", "energy_balance_error", "patch_fraction", "n_elements",
              "wall_time_s", "history")  # fmt: skip
 HISTORY_KEYS = ("t", "contact_force", "ball_velocity", "kinetic", "elastic",
-                "plastic_dissipation", "contact_work", "coupling_work")  # fmt: skip
+                "plastic_dissipation", "contact_work", "coupling_work",
+                "friction_work")  # fmt: skip
 HISTORY_UNITS = {"t": "s", "contact_force": "N", "ball_velocity": "m/s", "kinetic": "J",
                   "elastic": "J", "plastic_dissipation": "J", "contact_work": "J",
-                  "coupling_work": "J"}  # fmt: skip
+                  "coupling_work": "J", "friction_work": "J"}  # fmt: skip
 INPUT_UNITS = {"regime": "", "model": "", "velocity": "m/s", "ball_radius": "m",
                "block_radius": "m", "block_height": "m", "patch_size": "m",
                "block_patch_size": "m", "fine_size": "m",
@@ -35,7 +36,8 @@ RESULT_UNITS = {"contact_duration": "s", "peak_force": "N", "restitution": "1",
                 "hertz_peak_force": "N", "hertz_contact_duration": "s",
                 "hertz_indentation": "m", "hertz_contact_radius": "m", "fine_size": "m",
                 "coarse_size": "m", "n_steps": "1", "contact_radius_cells": "1",
-                "band_max_plastic_strain": "1", "t_end": "s"}  # fmt: skip
+                "band_max_plastic_strain": "1", "t_end": "s",
+                "mean_step_ratio": "1"}  # fmt: skip
 
 def hertz(radius: float, mass: float, velocity: float, ball: IsotropicElastic,
           block: IsotropicElastic | None) -> dict[str, float]:  # fmt: skip
@@ -76,7 +78,8 @@ class BallImpactResult(JsonResult):
         ``contact_force``
         (N), ``ball_velocity`` (m/s, along z), ``kinetic``, ``elastic`` (strain energy of the
         elastic models and stored energy of the J2 one), ``plastic_dissipation``,
-        ``contact_work``, ``coupling_work`` (J).
+        ``contact_work`` (of the normal multipliers), ``coupling_work``, ``friction_work`` (of
+        the tangential multipliers, ≤ 0; 0 without friction) (J).
     hertz : dict
         Hertz's values (elastic regime; empty otherwise).
     contact_radius_cells : float
@@ -86,6 +89,10 @@ class BallImpactResult(JsonResult):
         elastic: a warning above 0.02).
     t_end : float
         The simulated time (s): the given one, or the default the run chose.
+    coarse_step_ratio : int
+        The multi-time-step bound M (1: one step for every model).
+    mean_step_ratio : float
+        The mean ratio m ≤ M the coarse models' macro steps used (1 without multi-time-step).
     """
 
     contact_duration: float
@@ -105,6 +112,8 @@ class BallImpactResult(JsonResult):
     contact_radius_cells: float = 0.0
     band_max_plastic_strain: float = 0.0
     t_end: float = 0.0
+    coarse_step_ratio: int = 1
+    mean_step_ratio: float = 1.0
     config: dict[str, Any] = field(default_factory=dict)
 
     def to_json(self) -> dict[str, Any]:

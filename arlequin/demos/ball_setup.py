@@ -280,8 +280,11 @@ class ImpactBodies:
         model, block, index, weight, transfer = part
         ub = u[self.system.dofmap[block].slice]
         state = states[block][index]
-        uj = ub if transfer is None else transfer @ ub
-        elastic = model.stored_energy(uj, state, weight)
+        if model.bulk_viscosity:
+            uj = ub if transfer is None else transfer @ ub
+            elastic = model.stored_energy(uj, state, weight)
+        else:  # the committed state is the one at u: its own τ gives ψ (no kinematics)
+            elastic = model.stored_energy_of_state(state, weight)
         if self.zoned is not None:
             k = self.system.block(block).terms[0].model.stiffness_matrix
             elastic += 0.5 * float(ub @ (k @ ub))
