@@ -1,4 +1,5 @@
-"""One patch glued to the coarse model: its description (:class:`Patch`) and its coupling.
+"""One patch glued to the coarse model: its coupling (the patch's description, :class:`Patch`,
+lives in :mod:`arlequin.patches` and is re-exported here).
 
 :class:`PatchCoupling` builds, for one patch, everything that ties it to the coarse model: the
 overlap (the shared integration mesh, :mod:`arlequin.overlap`), the classification of the patch
@@ -12,7 +13,6 @@ from __future__ import annotations
 import logging
 import warnings
 from collections.abc import Callable
-from dataclasses import dataclass
 from functools import cached_property
 from typing import Any
 
@@ -20,14 +20,14 @@ import numpy as np
 import scipy.sparse as sp
 from skfem import Basis
 
-from .contract import Model, check_protocol
 from .coupling import CouplingMatrices, MediatorError, coupling_matrices
 from .geometry import distance_to_facets, facet_coordinates, outward_normals
 from .locate import cell_centroids, cell_sizes, locate_points
 from .overlap import Overlap, build_overlap
+from .patches import Patch
 from .reference import scalar_element_for
 from .system import BlockTerm
-from .weights import PartitionWeights, check_partition_of_unity, make_weights
+from .weights import PartitionWeights, check_partition_of_unity
 
 __all__ = ["ExactnessWarning", "Patch", "PatchCoupling"]
 
@@ -37,65 +37,6 @@ class ExactnessWarning(UserWarning):
     reproduced exactly (the message names the condition and a setting that meets it)."""
 
 logger = logging.getLogger(__name__)
-
-
-@dataclass
-class Patch:
-    """A refined model superposed on part of the coarse model.
-
-    Parameters
-    ----------
-    model : Model
-        The patch's model on its own (fine) mesh.
-    gluing_width : float, optional
-        Width (m) of the gluing band inside the patch along its interior boundary (the part of
-        its boundary inside the coarse domain). Snapped outwards to the fine cells whose centroid
-        lies within it, so the band's inner edge is made of fine-cell faces.
-    weights : {"ramp", "constant"} or PartitionWeights
-    epsilon : float
-        Floor of α_coarse inside the patch beyond the band.
-    coupling : {"L2", "H1"}
-    mediator : {"coarse", "fine"}
-    length : float, optional
-        H1 coupling length ℓ (m); default: the mean coarse cell size on the gluing zone
-        (:meth:`PatchCoupling.default_h1_length`).
-    gluing_region : callable, optional
-        Instead of a band: fine cells whose centroid x (dim, n) satisfies ``gluing_region(x)``.
-    overlap_method : {"auto", "nested", "intersection"}
-        See :func:`arlequin.overlap.build_overlap`.
-    boundary_tol : float
-        Fraction of the local coarse cell size within which patch points outside the coarse mesh
-        are accepted (faceted curved boundaries) and patch facets count as lying on the coarse
-        boundary.
-    name : str, optional
-        Block name; default ``"patch<i>"``.
-    """
-
-    model: Any
-    gluing_width: float | None = None
-    weights: str | PartitionWeights = "ramp"
-    epsilon: float = 1e-3
-    coupling: str = "H1"
-    mediator: str = "coarse"
-    length: float | None = None
-    gluing_region: Callable[[np.ndarray], np.ndarray] | None = None
-    overlap_method: str = "auto"
-    boundary_tol: float = 0.05
-    name: str | None = None
-
-    def __post_init__(self) -> None:
-        check_protocol(self.model, Model, "the patch's model")
-        if self.gluing_width is None and self.gluing_region is None:
-            raise ValueError("a patch needs a gluing_width (m) or a gluing_region")
-        if self.gluing_width is not None and not self.gluing_width > 0.0:
-            raise ValueError(f"gluing_width must be positive, got gluing_width={self.gluing_width}")
-        if self.coupling not in ("L2", "H1"):
-            raise ValueError(f"coupling must be 'L2' or 'H1', got {self.coupling!r}")
-        if self.mediator not in ("coarse", "fine"):
-            raise ValueError(f"mediator must be 'coarse' or 'fine', got {self.mediator!r}")
-        if self.length is not None and not self.length > 0.0:
-            raise ValueError(f"H1 length must be positive, got length={self.length}")
-        self.weights = make_weights(self.weights, self.epsilon)
 
 
 class PatchCoupling:
@@ -446,8 +387,8 @@ class PatchCoupling:
         Nested overlaps: the patch's outer facets (the integration mesh is the patch mesh).
         Intersection meshes give every cell its own nodes, so each of their facets is a
         "boundary" facet: those on the coarse boundary are the pieces of the patch's outer
-        facets, i.e. the facets whose vertices all lie on an outer facet (within 1e-9 of the
-        facet's size).
+        facets, i.e. the facets whose vertices and centroid all lie on an outer facet (within
+        1e-9 of the facet's size).
         """
         imesh = self.overlap.integration_mesh
         if self.overlap.method == "nested":
@@ -455,11 +396,21 @@ class PatchCoupling:
         bf = imesh.boundary_facets()
         if self.outer_facets.size == 0:
             return bf[:0]
-        outer = facet_coordinates(self.fine_model.mesh, self.outer_facets)
+        fmesh = self.fine_model.mesh
+        # only the cells of I inside a fine cell with an outer facet can have one
+        with_outer = np.zeros(fmesh.nelements, dtype=bool)
+        with_outer[fmesh.f2t[0, self.outer_facets]] = True
+        bf = bf[with_outer[self.overlap.fine_cells[imesh.f2t[0, bf]]]]
+        outer = facet_coordinates(fmesh, self.outer_facets)
         verts = imesh.facets[:, bf]  # (n_v, n_f)
         x = imesh.p[:, verts]  # (dim, n_v, n_f)
         size = np.max(np.linalg.norm(x - x[:, :1], axis=0), axis=0)  # (n_f,)
         if imesh.dim() == 1:
-            size = cell_sizes(self.fine_model.mesh).min() * np.ones(bf.size)
-        d = distance_to_facets(x.reshape(imesh.dim(), -1), outer).reshape(verts.shape)
-        return bf[np.all(d <= 1e-9 * size[None, :], axis=0)]
+            size = cell_sizes(fmesh).min() * np.ones(bf.size)
+        cap = 1e-9 * float(size.max()) if size.size else 0.0  # exact below it: all we need
+        d = distance_to_facets(x.reshape(imesh.dim(), -1), outer, cap=cap).reshape(verts.shape)
+        # and its centroid: a 3D facet whose vertices lie on two outer faces meeting at an
+        # edge (an interior face of a corner cell) has its centroid off both
+        dc = distance_to_facets(x.mean(axis=1), outer, cap=cap)
+        on = np.all(d <= 1e-9 * size[None, :], axis=0) & (dc <= 1e-9 * size)
+        return bf[on]

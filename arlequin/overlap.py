@@ -20,10 +20,11 @@ quadrature, is exact. Three constructions:
 ``intersection``
     2D non-nested simplices: I is made of the triangles of the exact polygon intersections of
     fine and coarse cells (shapely/GEOS clipping, then a fan triangulation), each with its own
-    nodes (a discontinuous P1 space on I).
+    nodes (a discontinuous P1 space on I); 3D non-nested tetrahedra: the tetrahedra of the exact
+    convex-polyhedron intersections (:mod:`arlequin.intersect3d`), likewise.
 
-3D non-nested meshes and non-nested quadrilaterals are refused with a clear error: there the
-intersection is not implemented (use a nested patch).
+Non-nested quadrilaterals and hexahedra are refused with a clear error: bilinear and trilinear
+cells have no exact intersection (use a nested patch).
 """
 
 from __future__ import annotations
@@ -33,7 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-from skfem import Mesh, MeshLine, MeshTri
+from skfem import Mesh, MeshLine, MeshTet, MeshTri
 
 from .dofs import vector_operator
 from .locate import LocateResult, cell_centroids, cell_sizes, locate_points
@@ -194,10 +195,12 @@ def build_overlap(coarse: Mesh, fine: Mesh, method: str = "auto", tol: float = 0
         return _merged_1d(coarse, fine, tol)
     if isinstance(fine, MeshTri):
         return _intersection_2d(coarse, fine)
+    if isinstance(fine, MeshTet):
+        return _intersection_3d(coarse, fine)
     raise OverlapError(
         f"non-nested overlap of {type(fine).__name__} meshes is not supported (exact intersection "
-        "exists for 1D lines and 2D triangles); build the patch by refining coarse cells "
-        "(arlequin.refine_region) or use triangles"
+        "exists for 1D lines, 2D triangles and 3D tetrahedra); build the patch by refining "
+        "coarse cells (arlequin.refine_region) or use simplices"
     )
 
 
@@ -293,3 +296,24 @@ def _intersection_2d(coarse: Mesh, fine: Mesh) -> Overlap:
         fi[poly_of_tri],
         "intersection",
     )
+
+
+def _intersection_3d(coarse: Mesh, fine: Mesh) -> Overlap:
+    from .intersect3d import tetrahedra_intersections
+
+    if not isinstance(coarse, MeshTet):
+        raise OverlapError("non-nested 3D overlaps need tetrahedral meshes on both sides")
+    tets, fcell, ccell = tetrahedra_intersections(
+        np.transpose(fine.p[:, fine.t], (2, 1, 0)), np.transpose(coarse.p[:, coarse.t], (2, 1, 0))
+    )
+    n = tets.shape[0]
+    if n == 0:
+        raise OverlapError("the patch mesh does not intersect the coarse mesh")
+    p = np.ascontiguousarray(tets.reshape(-1, 3).T)
+    mesh = MeshTet(p, np.ascontiguousarray(np.arange(4 * n).reshape(n, 4).T))
+    fnodes, cnodes = np.repeat(fcell, 4), np.repeat(ccell, 4)
+    p_coarse = interpolation_matrix(coarse, cnodes, _simplex_ref(coarse, cnodes, p))
+    p_fine = interpolation_matrix(fine, fnodes, _simplex_ref(fine, fnodes, p))
+    logger.info("intersection overlap: %d tetrahedra for %d patch cells", n, fine.nelements)
+    return Overlap(coarse, fine, mesh, p_coarse.tocsr(), p_fine.tocsr(), ccell, fcell,
+                   "intersection")  # fmt: skip

@@ -1,8 +1,9 @@
-"""The one round-trip helper of the results writers: read a folder back and compare.
+"""The one round-trip helper of the readers and writers: write, read back and compare.
 
 Every writer's output is read with the readers a user has (meshio for the XDMF series, the csv
 module for the histories, json for results.json) and compared with the in-memory result to
-round-off (the files store float64: equality is exact).
+round-off (the files store float64: equality is exact). User meshes go the other way: written
+by meshio in a format, read by :func:`arlequin.io.read_mesh`, compared cell by cell.
 """
 
 from __future__ import annotations
@@ -55,3 +56,26 @@ def assert_history_equal(folder: Path, columns: dict[str, np.ndarray], name: str
     hist = read_history(Path(folder) / meta["files"]["history"][name])
     for col, values in columns.items():
         np.testing.assert_array_equal(np.asarray(hist[col]), np.asarray(values, dtype=float))
+
+
+def _cells_as_points(mesh) -> np.ndarray:
+    """Each cell as the sorted coordinates of its nodes: independent of the node numbering."""
+    cells = np.round(mesh.p[:, mesh.t].transpose(2, 1, 0), 12)  # (n_cells, n_nodes, dim)
+    keyed = np.array([sorted(map(tuple, c)) for c in cells])
+    return keyed[np.lexsort(keyed.reshape(len(keyed), -1).T[::-1])]
+
+
+def assert_mesh_round_trip(mesh, path: Path, **write_options):
+    """Write a scikit-fem mesh with meshio to ``path`` (its format from the extension, or
+    ``file_format=`` in the options), read it back with :func:`arlequin.io.read_mesh` and check
+    the same mesh comes back (type, node and cell counts, every cell's nodes). Returns it."""
+    import skfem
+
+    from arlequin.io import read_mesh
+
+    skfem.io.meshio.to_file(mesh, str(path), **write_options)
+    back = read_mesh(path)
+    assert type(back) is type(mesh)
+    assert back.p.shape == mesh.p.shape and back.t.shape == mesh.t.shape
+    assert np.array_equal(_cells_as_points(back), _cells_as_points(mesh))
+    return back

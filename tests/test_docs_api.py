@@ -18,7 +18,7 @@ def rows():
         if len(cells) < 3 or not cells[0].startswith("`"):
             continue
         names = re.findall(r"`([A-Za-z_][A-Za-z0-9_]*)`", cells[0])
-        modules = re.findall(r"`(arlequin[a-z_.]*)`", cells[1])
+        modules = re.findall(r"`(arlequin[a-z0-9_.]*)`", cells[1])
         yield names, modules, cells[1]
 
 
@@ -28,13 +28,13 @@ def test_every_documented_name_lives_where_the_page_says():
         assert modules, where
         # a parenthesis "(`x` also `arlequin`)" lists extra places for some of the names only
         main, _, extra = where.partition("(")
-        main_modules = re.findall(r"`(arlequin[a-z_.]*)`", main)
+        main_modules = re.findall(r"`(arlequin[a-z0-9_.]*)`", main)
         extra_names = re.findall(r"`([A-Za-z_][A-Za-z0-9_]*)`", extra)
         for name in names:
             for mod in main_modules:
                 if not hasattr(importlib.import_module(mod), name):
                     missing.append((name, mod))
-        extra_modules = [m for m in re.findall(r"`(arlequin[a-z_.]*)`", extra)]
+        extra_modules = [m for m in re.findall(r"`(arlequin[a-z0-9_.]*)`", extra)]
         for name in extra_names:
             if name.startswith("arlequin"):
                 continue

@@ -56,7 +56,7 @@ def test_cli_patch_test_writes_json(tmp_path, capsys):
 
 
 def test_cli_reports_errors_cleanly(capsys):
-    assert main(["patch-test", "--dim", "3", "--mesh", "nonnested"]) == 2
+    assert main(["patch-test", "--dim", "3", "--layout", "strip"]) == 2  # a 2D-only layout
     assert "error" in capsys.readouterr().err
 
 

@@ -173,22 +173,31 @@ def _build_2d(rng, mesh_kind, axisymmetric):
 
 
 def _build_3d(rng, mesh_kind):
-    if mesh_kind != "nested":
-        raise ValueError(
-            "mesh='nonnested' with dim=3 is not available: exact 3D mesh intersection is not "
-            "implemented (use a nested patch)"
-        )
     n_along, length = 9, 2.0
     i0, nb = 1, 1
     i1 = i0 + 2 * nb + 3
     x, w = _columns(rng, n_along, length, i0, i1, nb)
     y = np.concatenate([[0.0], np.cumsum(_spacing(2, 1.0, rng))])
     z = np.concatenate([[0.0], np.cumsum(_spacing(2, 1.0, rng))])
-    coarse = skfem.MeshHex.init_tensor(x, y, z)
+    if mesh_kind == "nested":
+        coarse = skfem.MeshHex.init_tensor(x, y, z)
+        coarse = _perturb(coarse, rng, [1, 2], [0.1, 0.1], lambda p: np.ones(p.shape[1], bool))
+        cen = coarse.p[:, coarse.t].mean(axis=1)[0]
+        sel = np.nonzero((cen > x[i0]) & (cen < x[i1]))[0]
+        fine = refine_region(coarse, levels=1, cells=sel)
+        return coarse, fine, w
+    # non-nested tetrahedra: the coarse grid's tetrahedra, and a patch slab (x in [a, b], all
+    # of y and z) on its own grid, its band edges a + w and b − w node planes, both perturbed
+    # across (the planes x = const stay planes: the ramp weights stay exact on the bands)
+    coarse = skfem.MeshTet.init_tensor(x, y, z)
     coarse = _perturb(coarse, rng, [1, 2], [0.1, 0.1], lambda p: np.ones(p.shape[1], bool))
-    cen = coarse.p[:, coarse.t].mean(axis=1)[0]
-    sel = np.nonzero((cen > x[i0]) & (cen < x[i1]))[0]
-    fine = refine_region(coarse, levels=1, cells=sel)
+    a = x[i0] + rng.uniform(0.1, 0.4) * (x[i0 + 1] - x[i0])
+    b = x[i1] - rng.uniform(0.1, 0.4) * (x[i1] - x[i1 - 1])
+    xf = _breakpoints([(a, a + w), (a + w, b - w), (b - w, b)], (2, 5, 2), rng)
+    yf = np.concatenate([[0.0], np.cumsum(_spacing(3, 1.0, rng))])
+    zf = np.concatenate([[0.0], np.cumsum(_spacing(3, 1.0, rng))])
+    fine = skfem.MeshTet.init_tensor(xf, yf, zf)
+    fine = _perturb(fine, rng, [1, 2], [0.1, 0.1], lambda p: np.ones(p.shape[1], bool))
     return coarse, fine, w
 
 

@@ -2,7 +2,8 @@
 
 ``folder`` (:class:`ResultsFolder`: results.json, files), ``history`` (CSV written row by row),
 ``fields`` (XDMF series written frame by frame), ``layout`` (system vectors -> mesh fields),
-``run`` (writers of dynamic and static runs). The core's integrators never import this package;
+``run`` (writers of dynamic and static runs), ``meshes`` (user meshes read through meshio:
+:func:`read_mesh`). The core's integrators never import this package;
 demos and the CLI do.
 """
 
@@ -10,6 +11,7 @@ from .fields import FieldSeries, meshio_mesh, read_series
 from .folder import RESULTS_JSON, JsonResult, ResultsFolder, environment, jsonable
 from .history import HistoryCSV, read_history
 from .layout import BlockFields, FieldLayout
+from .meshes import UnsupportedMeshError, read_mesh
 from .run import DynamicRunWriter, write_static
 
 __all__ = [
@@ -21,10 +23,12 @@ __all__ = [
     "HistoryCSV",
     "JsonResult",
     "ResultsFolder",
+    "UnsupportedMeshError",
     "environment",
     "jsonable",
     "meshio_mesh",
     "read_history",
+    "read_mesh",
     "read_series",
     "write_static",
 ]
