@@ -29,7 +29,7 @@ from .reference import scalar_element_for
 from .system import BlockTerm
 from .weights import PartitionWeights, check_partition_of_unity
 
-__all__ = ["ExactnessWarning", "Patch", "PatchCoupling"]
+__all__ = ["ExactnessWarning", "PatchCoupling"]  # Patch: arlequin.patches (imported here too)
 
 
 class ExactnessWarning(UserWarning):
@@ -149,8 +149,12 @@ class PatchCoupling:
             f"{bad.size} {which} mediator function(s) see different gradients of the ramp "
             f"weight on the gluing zone (the worst at x = ({x}) m: the band turns a corner, is "
             "curved, or one function meets two bands), so σ·∇α_c is not in the mediator space "
-            "(condition B of docs/theory.md) and a uniform stress is not reproduced exactly: "
-            "use mediator='fine' on a nested patch (condition A), or straight bands whose "
+            "(condition B of docs/theory.md) and a uniform stress is not reproduced exactly"
+            + (" (with the coarse mediator on a non-nested 3D patch whose band turns edges, the "
+               "error reached the size of the solution itself)" if coarse and
+               self.overlap.method != "nested" and mesh.dim() == 3 else "")
+            + ": use mediator='fine' (exact on a nested patch, condition A; on a non-nested one "
+            "far closer), or straight bands whose "
             f"{which} mediator functions each meet a single band"
         ]
 

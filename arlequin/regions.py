@@ -35,6 +35,8 @@ class SurfaceRegion:
 
     Raises
     ------
+    FileNotFoundError
+        No such file.
     ValueError
         If the file has no triangles, or the surface is not closed (open edges: its inside is
         not defined) or its faces are not consistently oriented.
@@ -53,6 +55,8 @@ class SurfaceRegion:
         name = "the surface"
         if isinstance(surface, (str, os.PathLike)):
             name = f"surface file {os.fspath(surface)!r}"
+            if not os.path.isfile(os.fspath(surface)):
+                raise FileNotFoundError(f"{name} not found")
             surface = trimesh.load(os.fspath(surface), force="mesh")
         if not isinstance(surface, trimesh.Trimesh):
             raise ValueError(f"{name} must be a trimesh.Trimesh or a file trimesh reads as one "

@@ -369,7 +369,7 @@ class FiniteStrainJ2:
 
     def stored_energy_of_state(self, state: PlasticState, weight: WeightLike = None) -> float:
         """Elastic stored energy Σ w₀ ψ (J) from a state's own Kirchhoff stress: for the Hencky
-        law τ = K ln J 1 + 2G dev ε_e, so ψ = (tr τ)²/(18 K) + |dev τ|²/(4 G).
+        law τ = K ln J 1 + 2G dev ε_e, so ψ = (tr τ)²/(18 K) + ‖dev τ‖²/(4 G).
 
         The same as :meth:`stored_energy` at the displacement the state was evaluated at (to
         round-off), without recomputing the kinematics: a product per quadrature point.

@@ -80,3 +80,12 @@ def test_unsupported_meshes_are_refused():
         read_mesh(meshio.Mesh(quad, [("quad", np.array([[0, 1, 2, 3]]))]))
     with pytest.raises(ValueError, match="scale"):
         read_mesh(meshio.Mesh(quad, [("quad", np.array([[0, 2, 1, 3]]))]), scale=0.0)
+
+
+def test_unreadable_and_missing_files_are_clear_errors(tmp_path):
+    junk = tmp_path / "junk.msh"
+    junk.write_text("not a mesh\n")
+    with pytest.raises(MeshError, match="could not read"):  # meshio exits; not the process
+        read_mesh(junk)
+    with pytest.raises(FileNotFoundError, match="missing.vtu"):
+        read_mesh(tmp_path / "missing.vtu")

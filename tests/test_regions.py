@@ -131,3 +131,8 @@ def test_a_patch_from_a_surface_is_the_patch_from_its_level_set(tmp_path):
     u_b, _ = _solve(Patch.from_box(coarse, box, model, levels=1, **options), coarse)
     assert np.array_equal(u_s, u_l) and np.array_equal(u_s, u_b)
     assert max(err_s, err_l) < 1e-10 * 3e-3  # relative to the largest displacement, 3 mm
+
+
+def test_a_missing_surface_file_is_a_clear_error(tmp_path):
+    with pytest.raises(FileNotFoundError, match="nope.stl"):
+        SurfaceRegion(tmp_path / "nope.stl")

@@ -62,9 +62,12 @@ def read_mesh(source: Any, scale: float = 1.0) -> skfem.Mesh:
     UnsupportedMeshError
         Mixed types in the highest dimension, or a type outside :data:`SUPPORTED`.
     MeshError
-        A 2D mesh not in a plane z = const, inverted or degenerate cells (the cell named).
+        A file meshio cannot read, a 2D mesh not in a plane z = const, folded or degenerate
+        cells (the cell named).
     ValueError
         A scale that is not a positive finite number.
+    FileNotFoundError
+        No such file.
     """
     import meshio
 
@@ -73,7 +76,15 @@ def read_mesh(source: Any, scale: float = 1.0) -> skfem.Mesh:
     name = "the mesh"
     if not isinstance(source, meshio.Mesh):
         name = f"mesh file {os.fspath(source)!r}"
-        source = meshio.read(os.fspath(source))
+        if not os.path.isfile(os.fspath(source)):
+            raise FileNotFoundError(f"{name} not found")
+        try:
+            source = meshio.read(os.fspath(source))
+        except SystemExit as exc:  # meshio exits on a file no reader accepts
+            raise MeshError(f"{name}: meshio could not read it (not a mesh, or a format it "
+                            "guesses wrongly from the extension)") from exc
+        except Exception as exc:
+            raise MeshError(f"{name}: meshio could not read it: {exc}") from exc
     types = sorted({block.type for block in source.cells if len(block.data)})
     if not types:
         raise UnsupportedMeshError(f"{name} has no cells")
