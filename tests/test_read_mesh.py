@@ -87,5 +87,5 @@ def test_unreadable_and_missing_files_are_clear_errors(tmp_path):
     junk.write_text("not a mesh\n")
     with pytest.raises(MeshError, match="could not read"):  # meshio exits; not the process
         read_mesh(junk)
-    with pytest.raises(FileNotFoundError, match="missing.vtu"):
+    with pytest.raises(FileNotFoundError, match=r"missing\.vtu"):
         read_mesh(tmp_path / "missing.vtu")

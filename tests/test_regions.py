@@ -134,5 +134,5 @@ def test_a_patch_from_a_surface_is_the_patch_from_its_level_set(tmp_path):
 
 
 def test_a_missing_surface_file_is_a_clear_error(tmp_path):
-    with pytest.raises(FileNotFoundError, match="nope.stl"):
+    with pytest.raises(FileNotFoundError, match=r"nope\.stl"):
         SurfaceRegion(tmp_path / "nope.stl")
