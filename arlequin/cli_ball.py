@@ -106,8 +106,7 @@ def add_ball_impact(sub) -> None:
                    help="the ball against a rigid plane instead of the block")
     p.add_argument("--coarse-step-ratio", type=int, default=None, metavar="M",
                    help="multi-time-step: the coarse models' forces once every m <= M steps, "
-                   "the largest stable m (1: off; default 2^levels, the coarse over the fine "
-                   "size, with --model arlequin)")  # fmt: skip
+                   "the largest stable m (1: off; default 2 with --model arlequin)")  # fmt: skip
     p.add_argument("--t-end", type=float, default=None, metavar="T",
                    help="simulated time (s); default 1.4 x Hertz's contact duration (elastic)")
     p.add_argument("--json", metavar="PATH", default=None, help="write the results as JSON")

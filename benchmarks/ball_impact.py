@@ -41,7 +41,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--models", default="arlequin,arlequin-1,mono,mono-zoned,graded")
     parser.add_argument("--rigid-wall", action="store_true")
     parser.add_argument("--coarse-step-ratio", type=int, default=None,
-                        help="arlequin's multi-time-step ratio (default: the demo's, 2^levels)")
+                        help="arlequin's multi-time-step ratio (default: the demo's, 2)")
     parser.add_argument("--coarse-size", type=float, default=None)
     parser.add_argument("--fine-size", type=float, default=None)
     parser.add_argument("--friction", type=float, default=0.0, help="Coulomb μ between the bodies")
