@@ -53,8 +53,9 @@ def candidate_pairs(fine_cells: np.ndarray, coarse_cells: np.ndarray) -> tuple[n
     r_f = np.max(np.linalg.norm(fine_cells - f_mid[:, None], axis=2), axis=1)
     tree = cKDTree(c_mid)
     lists = tree.query_ball_point(f_mid, r_f + r_c.max() * (1 + 1e-9))
-    fi = np.repeat(np.arange(len(lists)), [len(x) for x in lists])
-    ci = np.fromiter((j for x in lists for j in x), dtype=np.int64, count=fi.size)
+    sizes = np.fromiter(map(len, lists), dtype=np.int64, count=len(lists))
+    fi = np.repeat(np.arange(len(lists)), sizes)
+    ci = np.concatenate(lists).astype(np.int64) if fi.size else np.zeros(0, np.int64)
     lo_f, hi_f = fine_cells.min(axis=1), fine_cells.max(axis=1)
     lo_c, hi_c = coarse_cells.min(axis=1), coarse_cells.max(axis=1)
     pad = 1e-9 * (hi_f - lo_f).max(axis=1)[fi, None]

@@ -26,9 +26,8 @@ __all__ = ["SUPPORTED", "UnsupportedMeshError", "read_mesh"]
 
 logger = logging.getLogger(__name__)
 
-#: meshio cell type -> the scikit-fem mesh class it becomes.
-SUPPORTED = {"triangle": skfem.MeshTri, "quad": skfem.MeshQuad, "tetra": skfem.MeshTet,
-             "hexahedron": skfem.MeshHex}  # fmt: skip
+#: The meshio cell types read (scikit-fem's MeshTri, MeshQuad, MeshTet, MeshHex).
+SUPPORTED = ("hexahedron", "quad", "tetra", "triangle")
 
 
 class UnsupportedMeshError(MeshError):
@@ -97,7 +96,7 @@ def read_mesh(source: Any, scale: float = 1.0) -> skfem.Mesh:
     kind = main[0]
     if kind not in SUPPORTED:
         raise UnsupportedMeshError(f"{name} has cells of type {kind!r}, which no model of the "
-                                   f"library supports: give first-order {sorted(SUPPORTED)} "
+                                   f"library supports: give first-order {list(SUPPORTED)} "
                                    "cells (e.g. Gmsh's Mesh.ElementOrder = 1)")  # fmt: skip
     points = np.asarray(source.points, dtype=float)
     if top == 2 and points.shape[1] == 3 and np.ptp(points[:, 2]) > 0.0:
