@@ -43,7 +43,7 @@ def run_options(args: argparse.Namespace) -> dict:
     # the Arlequin options given on the command line (run_taylor_bar refuses those that do not
     # apply to the model, before any work)
     names = ("patch_length", "gluing_width", "coarse_size", "fine_size", "weights", "mediator",
-             "coupling", "coarse_step_ratio", "band_warning")  # fmt: skip
+             "coupling", "coarse_step_ratio", "band_warning", "patch_surface")  # fmt: skip
     arlequin = {k: getattr(args, k) for k in names if getattr(args, k) is not None}
     return dict(
         model=args.model, elements_radial=args.elements_radial, mesh_size=args.mesh_size,
@@ -51,7 +51,7 @@ def run_options(args: argparse.Namespace) -> dict:
         poisson=args.poisson, density=args.density, yield_stress=args.yield_stress,
         hardening=args.hardening, hardening_law=args.hardening_law, length=args.length,
         radius=args.radius, bulk_viscosity=args.bulk_viscosity, fbar=not args.no_fbar,
-        backend=args.backend, **arlequin, **law_params,
+        backend=args.backend, geometry=args.geometry, **arlequin, **law_params,
     )  # fmt: skip
 
 
@@ -77,12 +77,28 @@ def add_taylor_bar(sub) -> None:
         description="A bar (length L, radius R) moving at V hits a rigid frictionless wall at "
         "t = 0. Default (--model arlequin): a coarse linear-elastic model of the whole bar and a "
         "refined finite-strain J2 patch over the impacted end, glued by a mediator in a band at "
-        "the patch's top; --model mono: one finite-strain mesh. Axisymmetric Q1 F-bar cells, "
+        "the patch's top; --model mono: one finite-strain mesh. Axisymmetric Q1 F-bar cells "
+        "(--geometry 3d: a quarter bar of F-bar hexahedra), "
         "central differences with the step re-estimated in the current configuration, the "
         "level-set contact model at the wall (on the patch). SI units; lengths in m, element "
         "edges in the reference configuration. "
         "Reports the final length, the footprint (mushroom) radius, the maximum equivalent "
         "plastic strain and the energy balance error (a fraction).",
+    )
+    p.add_argument(
+        "--geometry",
+        choices=["axisymmetric", "3d"],
+        default="axisymmetric",
+        help="axisymmetric: Q1 cells of the (r, z) section (default); 3d: the quarter bar "
+        "x, y >= 0 of F-bar hexahedra on an O-grid section, symmetry conditions on x = 0 and "
+        "y = 0 (energies and forces of the quarter)",
+    )
+    p.add_argument(
+        "--patch-surface",
+        default=None,
+        metavar="FILE",
+        help="arlequin, --geometry 3d: the patch region as a closed surface (STL/OBJ/PLY, m): "
+        "the coarse cells whose centroid lies inside are refined (it must hold the impact face)",
     )
     p.add_argument(
         "--model",

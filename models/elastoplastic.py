@@ -3,9 +3,10 @@
 The model ties three pieces together: the Q1 kinematics with F-bar
 (:mod:`arlequin.models.kinematics`), the J2 material point (:mod:`arlequin.models.j2`: Hencky
 elasticity, exponential-map return, any hardening law of :mod:`arlequin.models.hardening`) and,
-for planar cells (axisymmetric, plane strain), the compiled kernel that fuses them
-(:mod:`arlequin.models.j2_kernel`, ``backend="numba"``, the default there). The numpy path
-(``backend="numpy"``) is the reference the kernel is tested against.
+for the built-in hardening laws, the compiled kernels that fuse them (``backend="numba"``, the
+default there): :mod:`arlequin.models.j2_kernel` for planar cells (axisymmetric, plane strain),
+:mod:`arlequin.models.j2_kernel_3d` for hexahedra. The numpy path (``backend="numpy"``) is the
+reference the kernels are tested against.
 
 Optional artificial bulk viscosity (off by default): on compression a pressure
 q = ρ (c_quad ℓ² ε̇_v² − c_lin ℓ c_d ε̇_v) (ε̇_v = J̄̇/J̄ from the step, ρ = ρ₀/J̄, ℓ the cell size)
@@ -126,11 +127,11 @@ class FiniteStrainJ2:
         self.kin = Q1Kinematics(
             mesh, kind, self.elastic.scalar_basis(), self.elastic.basis.nodal_dofs
         )
-        compiled = dim == 2 and material.law.kernel_code is not None
+        # the compiled kernels: planar Q1 (j2_kernel) and 8-node hexahedra (j2_kernel_3d)
+        compiled = material.law.kernel_code is not None
         if backend == "numba" and not compiled:
             raise ValueError(
-                "backend='numba' needs planar cells (axisymmetric, plane strain) and a built-in "
-                "hardening law; use backend='numpy'"
+                "backend='numba' needs a built-in hardening law; use backend='numpy'"
             )
         self.backend = "numba" if (backend == "auto" and compiled) else backend
         if self.backend == "auto":
@@ -168,8 +169,7 @@ class FiniteStrainJ2:
 
     def with_mesh(self, mesh: Mesh) -> FiniteStrainJ2:
         """Same material, kinematics, F-bar choice, backend and viscosity on another mesh."""
-        backend = self.backend if self.backend != "numba" or mesh.dim() == 2 else "auto"
-        return FiniteStrainJ2(mesh, self.material, self.kind, self.fbar, backend=backend,
+        return FiniteStrainJ2(mesh, self.material, self.kind, self.fbar, backend=self.backend,
                               bulk_viscosity=self.bulk_viscosity, validate=False)  # fmt: skip
 
     def nodal_dofs(self) -> np.ndarray:
@@ -308,6 +308,8 @@ class FiniteStrainJ2:
         return f, PlasticState(cp_inv, eqps, tau, J, state.plastic_work + work, wv)
 
     def _internal_force_numba(self, u, state, alpha, dt):
+        if self.dim == 3:
+            return self._internal_force_numba_3d(u, state, alpha, dt)
         from .j2_kernel import planar_j2_kernel, scratch
 
         kin = self.kin
@@ -317,11 +319,7 @@ class FiniteStrainJ2:
         if self._kernel_static is None:
             c = np.ascontiguousarray
             radius = kin.radius if kin.radius is not None else np.ones((ne, nq))
-            visc = np.zeros(4)
-            if self.bulk_viscosity:
-                bv = self.bulk_viscosity
-                visc[:] = (bv.linear, bv.quadratic, self.material.density,
-                           self.material.dilatational_wave_speed)  # fmt: skip
+            visc = self._viscosity_params()
             self._kernel_static = (
                 c(np.transpose(kin.cell_dofs, (2, 1, 0)), dtype=np.int64),
                 c(np.moveaxis(kin.grad, (0, 1), (2, 3))), c(np.moveaxis(kin.val, 0, -1)),
@@ -329,12 +327,8 @@ class FiniteStrainJ2:
                 visc, c(self._h0), *scratch(nq, nen),
             )  # fmt: skip
         dofs, grad, val, radius, dv0, visc, h0, s_h, s_g, s_u = self._kernel_static
-        u = np.ascontiguousarray(u, dtype=float)
-        if u.shape != (kin.n_dofs,):
-            raise ValueError(f"displacement must have shape ({kin.n_dofs},), got {u.shape}")
-        out = [np.empty((2, nen, ne)), np.empty((3, 3, ne, nq)), np.empty((ne, nq)),
-               np.empty((3, 3, ne, nq)), np.empty((ne, nq)), np.empty((ne, nq)),
-               np.empty((ne, nq)), np.empty(ne, dtype=np.int64)]  # fmt: skip
+        u = self._checked_displacement(u)
+        out = self._kernel_outputs(2)
         c = np.ascontiguousarray
         planar_j2_kernel(
             u, dofs, grad, val, radius, dv0, c(np.broadcast_to(alpha, (ne, nq)), dtype=float),
@@ -344,6 +338,60 @@ class FiniteStrainJ2:
             c(state.plastic_work), c(state.viscous_work), c(state.jacobian), visc, h0,
             s_h, s_g, s_u, *out,
         )  # fmt: skip
+        return self._gathered(out)
+
+    def _internal_force_numba_3d(self, u, state, alpha, dt):
+        from .j2_kernel_3d import solid_j2_kernel, solid_scratch
+
+        kin = self.kin
+        ne, nq = self.shape
+        nen = kin.grad.shape[0]
+        law = self.material.law
+        c = np.ascontiguousarray
+        if self._kernel_static is None:
+            self._kernel_static = (
+                c(np.transpose(kin.cell_dofs, (2, 1, 0)), dtype=np.int64),
+                c(np.moveaxis(kin.grad, (0, 1), (2, 3))), c(kin.dv0), self._viscosity_params(),
+                c(self._h0), *solid_scratch(nq, nen),
+            )  # fmt: skip
+        dofs, grad, dv0, visc, h0, s_h, s_g, s_m = self._kernel_static
+        u = self._checked_displacement(u)
+        out = self._kernel_outputs(3)
+        solid_j2_kernel(
+            u, dofs, grad, dv0, c(np.broadcast_to(alpha, (ne, nq)), dtype=float), self.fbar,
+            self.material.bulk_modulus, self.material.shear_modulus, int(law.kernel_code),
+            law.kernel_params, -1.0 if dt is None else float(dt), c(state.cp_inv),
+            c(state.eqps), c(state.plastic_work), c(state.viscous_work), c(state.jacobian),
+            visc, h0, s_h, s_g, s_m, *out,
+        )  # fmt: skip
+        return self._gathered(out)
+
+    def _viscosity_params(self) -> np.ndarray:
+        """(c_linear, c_quadratic, ρ₀, c_d) of the bulk viscosity for the kernels (0: off)."""
+        visc = np.zeros(4)
+        if self.bulk_viscosity:
+            bv = self.bulk_viscosity
+            visc[:] = (bv.linear, bv.quadratic, self.material.density,
+                       self.material.dilatational_wave_speed)  # fmt: skip
+        return visc
+
+    def _checked_displacement(self, u) -> np.ndarray:
+        u = np.ascontiguousarray(u, dtype=float)
+        if u.shape != (self.kin.n_dofs,):
+            raise ValueError(f"displacement must have shape ({self.kin.n_dofs},), got {u.shape}")
+        return u
+
+    def _kernel_outputs(self, dim: int) -> list[np.ndarray]:
+        """The kernels' output buffers: forces, C_p⁻¹, ε̄p, τ, J, works, flags."""
+        ne, nq = self.shape
+        nen = self.kin.grad.shape[0]
+        return [np.empty((dim, nen, ne)), np.empty((3, 3, ne, nq)), np.empty((ne, nq)),
+                np.empty((3, 3, ne, nq)), np.empty((ne, nq)), np.empty((ne, nq)),
+                np.empty((ne, nq)), np.empty(ne, dtype=np.int64)]  # fmt: skip
+
+    def _gathered(self, out: list[np.ndarray]):
+        """The kernel's outputs as (nodal force, PlasticState); flagged cells raise."""
+        kin = self.kin
         fe, cp_inv, eqps, tau, J, wp, wv, flags = out
         if np.any(flags):
             bad = np.nonzero(flags)[0]

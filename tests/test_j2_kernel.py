@@ -1,4 +1,5 @@
-"""The compiled J2 kernel (models/j2_kernel.py) against the numpy reference path.
+"""The compiled J2 kernels (models/j2_kernel.py, planar; models/j2_kernel_3d.py, hexahedra)
+against the numpy reference path.
 
 Both evaluate the same formulas (Q1 kinematics with F-bar, b_e − 1 without round-off, the
 exponential-map return, the bulk viscosity, the consistent force), one point by point and one
@@ -34,13 +35,17 @@ MATERIALS = {
 RTOL = 1e-12
 
 
-def mesh(n: int = 4, seed: int = 1) -> skfem.Mesh:
+def mesh(n: int = 4, seed: int = 1, dim: int = 2) -> skfem.Mesh:
+    if dim == 3:  # 3 × 3 × 4 distorted hexahedra
+        m = skfem.MeshHex.init_tensor(*[np.linspace(0.0, 3.2e-3, 4)] * 2,
+                                      np.linspace(0.0, 4e-3, 5))  # fmt: skip
+        return perturb(m, 3.2e-3 / 3, 0.2, seed)
     m = skfem.MeshQuad.init_tensor(np.linspace(0.0, 3.2e-3, n + 1), np.linspace(0.0, 4e-3, n + 2))
     return perturb(m, 3.2e-3 / n, 0.25, seed)
 
 
 def pair(kind, name, fbar=True, **kwargs):
-    m = mesh()
+    m = mesh(dim=3 if kind == "3d" else 2)
     mat = MATERIALS[name]
     return (FiniteStrainJ2(m, mat, kind, fbar, backend="numpy", **kwargs),
             FiniteStrainJ2(m, mat, kind, fbar, backend="numba", **kwargs))  # fmt: skip
@@ -50,7 +55,8 @@ def random_u(model, amplitude, seed, compress=0.0):
     """Random nodal displacement (strains ~ amplitude) plus an axial compression."""
     rng = np.random.default_rng(seed)
     u = amplitude * 1e-3 * rng.uniform(-1, 1, model.n_dofs)
-    u[model.nodal_dofs()[1]] -= compress * model.mesh.p[1]
+    axis = model.dim - 1  # z in axisymmetry (r, z) and in 3D
+    u[model.nodal_dofs()[axis]] -= compress * model.mesh.p[axis]
     return u
 
 
@@ -71,7 +77,7 @@ def assert_same(a, b, what):
         assert err <= RTOL, f"{what}: {name} differs by {err:.2e} (relative)"
 
 
-@pytest.mark.parametrize("kind", ["axisymmetric", "plane_strain"])
+@pytest.mark.parametrize("kind", ["axisymmetric", "plane_strain", "3d"])
 @pytest.mark.parametrize("name", sorted(MATERIALS))
 @pytest.mark.parametrize("fbar", [True, False])
 def test_kernel_equals_numpy_on_random_states(kind, name, fbar):
@@ -88,14 +94,17 @@ def test_kernel_equals_numpy_on_random_states(kind, name, fbar):
     # a second step from a committed plastic state, unloading in part of the mesh (mixed)
     u1 = random_u(ref, 0.05, seed=4, compress=0.2)
     s1 = ref.internal_force(u1, dt=dt)[1]
-    u2 = u1 + random_u(ref, 0.01, seed=5, compress=-0.01)
+    if kind == "3d":  # a slight pull-back plus noise: 3D points all flow on the planar recipe
+        u2 = 0.999 * u1 + random_u(ref, 0.002, seed=5)
+    else:
+        u2 = u1 + random_u(ref, 0.01, seed=5, compress=-0.01)
     a, b = ref.internal_force(u2, s1, dt=dt), fast.internal_force(u2, s1, dt=dt)
     assert_same(a, b, "second step")
     grew = a[1].eqps > s1.eqps
     assert grew.any() and not grew.all()  # both branches at once
 
 
-@pytest.mark.parametrize("kind", ["axisymmetric", "plane_strain"])
+@pytest.mark.parametrize("kind", ["axisymmetric", "plane_strain", "3d"])
 def test_kernel_equals_numpy_with_bulk_viscosity_and_weight(kind):
     ref, fast = pair(kind, "linear", bulk_viscosity=True)
     assert ref.uses_time_step and fast.uses_time_step
@@ -110,9 +119,10 @@ def test_kernel_equals_numpy_with_bulk_viscosity_and_weight(kind):
     assert ref.viscous_dissipation(a[1], alpha) > 0.0
 
 
-def test_kernel_and_numpy_agree_on_the_smallest_strains():
+@pytest.mark.parametrize("kind", ["axisymmetric", "3d"])
+def test_kernel_and_numpy_agree_on_the_smallest_strains(kind):
     # b_e − 1 is assembled without forming 1 + ε: the force stays linear in u down to 1e-15
-    ref, fast = pair("axisymmetric", "linear")
+    ref, fast = pair(kind, "linear")
     u = random_u(ref, 1.0, seed=8)
     f1 = fast.internal_force(1e-6 * u)[0]
     for scale in [1e-9, 1e-12]:
@@ -121,13 +131,14 @@ def test_kernel_and_numpy_agree_on_the_smallest_strains():
             assert np.allclose(f, scale * f1, rtol=0, atol=1e-5 * scale * np.abs(f1).max())
 
 
-def test_kernel_reports_an_inverted_cell_by_id():
-    _, fast = pair("plane_strain", "linear")
+@pytest.mark.parametrize("kind", ["plane_strain", "3d"])
+def test_kernel_reports_an_inverted_cell_by_id(kind):
+    _, fast = pair(kind, "linear")
     p = fast.mesh.p
-    corner = int(np.argmax(p[0] + p[1]))  # the top-right corner node: in one cell only
+    corner = int(np.argmax(p.sum(axis=0)))  # the top-right corner node: in one cell only
     cell = int(np.nonzero((fast.mesh.t == corner).any(axis=0))[0][0])
     u = np.zeros(fast.n_dofs)
-    u[fast.nodal_dofs()[:, corner]] = -2e-3  # pushed across the cell's diagonal
+    u[fast.nodal_dofs()[:, corner]] = -4e-3  # pushed across the cell's diagonal
     with pytest.raises(InvertedElementError, match=f"cell {cell}: det F <= 0 \\(1 such cells\\)"):
         fast.internal_force(u)
 
@@ -144,7 +155,7 @@ def test_backend_choice():
     with pytest.raises(ValueError, match="backend must be one of"):
         FiniteStrainJ2(m, COPPER, backend="cuda")
     hexes = skfem.MeshHex.init_tensor(*[np.linspace(0, 1e-3, 2)] * 3)
-    assert FiniteStrainJ2(hexes, COPPER).backend == "numpy"
+    assert FiniteStrainJ2(hexes, COPPER).backend == "numba"  # the hexahedral kernel
 
 
 def test_callable_law_matches_the_built_in_one():

@@ -48,14 +48,13 @@ from ..models import BulkViscosity, J2Material
 from ..weights import PartitionWeights
 from .taylor_checkpoint import CheckpointWriter, load_checkpoint, read_frames
 from .taylor_meshes import (
-    arlequin_bar_sizes,
     elements_radial_of,
     fine_radial,
-    graded_bar_mesh,
     positive,
     taylor_bar_mesh,
 )
-from .taylor_models import LAW_DEFAULTS, ArlequinBar, MonoBar, hardening_parameters
+from .taylor_models import LAW_DEFAULTS, ArlequinBar, hardening_parameters
+from .taylor_models_3d import ArlequinBar3D
 from .taylor_record import HISTORY_UNITS, MultiplierHistory, TaylorRecorder, write_results
 from .taylor_result import (
     ARLEQUIN_JSON_KEYS,
@@ -65,6 +64,7 @@ from .taylor_result import (
     GluingBandPlasticityWarning,
     TaylorBarResult,
 )
+from .taylor_setup import build_bar
 
 __all__ = [
     "ARLEQUIN_JSON_KEYS",
@@ -144,6 +144,8 @@ def run_taylor_bar(
     checkpoint_interval: float = 10e-6,
     resume: bool = False,
     check_only: bool = False,
+    geometry: str = "axisymmetric",
+    patch_surface: Any = None,
     **law_parameters: float,
 ) -> TaylorBarResult | None:
     """Run the Taylor bar impact (see the module docstring).
@@ -181,7 +183,9 @@ def run_taylor_bar(
         rows, and the coarse cell edge across the radius (default twice the fine size, or the
         smallest multiple dividing the radius for an odd count: 3 or 5 cells across give one
         coarse cell); ``graded`` uses patch_length and coarse_size too; see
-        :func:`~arlequin.demos.taylor_models.arlequin_bar_sizes`.
+        :func:`~arlequin.demos.taylor_models.arlequin_bar_sizes`. In 3D ``mono`` takes
+        ``coarse_size`` too: its mesh is then the coarse O-grid refined to the fine size (the
+        Arlequin patch's nodes over the whole bar).
     weights, mediator, coupling : str, optional
         ``arlequin`` only: ``"ramp"`` (default), ``"constant"`` (½ in the band) or any
         :class:`~arlequin.PartitionWeights`; the ``"fine"`` (default) or ``"coarse"`` mediator
@@ -224,6 +228,17 @@ def run_taylor_bar(
     check_only : bool
         Check every input and build the models, then return None without running or writing
         anything (a study checks its cases so before running any).
+    geometry : {"axisymmetric", "3d"}
+        ``"axisymmetric"`` (default): Q1 cells of the (r, z) section; ``"3d"``: the quarter bar
+        x, y ≥ 0 of 8-node F-bar hexahedra on an O-grid section with symmetry conditions
+        (:mod:`~arlequin.demos.taylor_models_3d`; energies and forces of the quarter;
+        ``elements_radial`` ≥ 2 counts the O-grid's cells across the radius, and for
+        ``arlequin`` the coarse size must be a power-of-two multiple of the fine size).
+    patch_surface : trimesh.Trimesh, path or SurfaceRegion, optional
+        ``arlequin`` with ``geometry="3d"`` only: the patch region as a closed surface (m): the
+        coarse cells whose centroid lies inside are refined (instead of the layers below
+        ``patch_length``). It must contain the impact face's cells and a band of whole layers at
+        its top (the gluing band is the top ``gluing_width`` of the patch).
     resume : bool
         Continue the interrupted run of the folder ``out`` from its last checkpoint (the inputs
         must be the same; :func:`resume_taylor_bar` reads them from the checkpoint). Everything
@@ -258,7 +273,9 @@ def run_taylor_bar(
         raise ValueError(f"{sorted(only_arlequin)} apply to model='arlequin' only, got "
                          f"model={model!r}")  # fmt: skip
     arlequin = model == "arlequin"
-    nested = model in ("arlequin", "graded")  # the patch's sizes apply
+    # the patch's sizes apply (3D mono with coarse_size: the coarse O-grid refined)
+    nested = model in ("arlequin", "graded") or (
+        model == "mono" and geometry == "3d" and coarse_size is not None)
     if not nested:
         extra = {k: v for k, v in (("patch_length", patch_length), ("coarse_size", coarse_size))
                  if v is not None}  # fmt: skip
@@ -311,29 +328,17 @@ def run_taylor_bar(
     if not isinstance(fbar, bool):
         raise ValueError(f"fbar must be True or False, got fbar={fbar!r}")
     visc = BulkViscosity() if bulk_viscosity is True else (bulk_viscosity or None)
-    config: dict[str, Any] = {"model": model}
-    if nested:
-        sizes = arlequin_bar_sizes(length, radius, n_r, coarse_size, patch_length, gluing_width)
-        config.update(sizes.as_dict())
-    if model == "graded":
-        bar: MonoBar | ArlequinBar = MonoBar(
-            length, radius, n_r, material, fbar, backend, visc,
-            mesh=graded_bar_mesh(length, radius, sizes), friction=friction,
-        )  # fmt: skip
-        n_z = 2 * sizes.patch_rows
-    elif arlequin:
-        bar = ArlequinBar(
-            length, radius, sizes, material, weights=weights, mediator=mediator,
-            coupling=coupling, fbar=fbar, backend=backend, bulk_viscosity=visc,
-            friction=friction,
-        )  # fmt: skip
-        n_z = sizes.patch_rows * sizes.ratio
+    config: dict[str, Any] = {"model": model, "geometry": geometry}
+    bar, n_z, sizes = build_bar(
+        model, geometry, length, radius, n_r, material, config, nested=nested,
+        coarse_size=coarse_size, patch_length=patch_length, gluing_width=gluing_width,
+        patch_surface=patch_surface, weights=weights, mediator=mediator, coupling=coupling,
+        fbar=fbar, backend=backend, bulk_viscosity=visc, friction=friction,
+    )  # fmt: skip
+    if arlequin:
         config.update(weights=str(weights), mediator=mediator, coupling=coupling,
                       coarse_step_ratio=int(coarse_step_ratio), band_warning=band_warning,
                       epsilon=bar.problem.patches[0].epsilon)  # fmt: skip
-    else:
-        bar = MonoBar(length, radius, n_r, material, fbar, backend, visc, friction=friction)
-        n_z = bar.mesh.t.shape[1] // n_r
     if check_only:  # every input checked, the models built: nothing run, nothing written
         return None
     fine_model = bar.model
@@ -351,8 +356,10 @@ def run_taylor_bar(
         config.update(bulk_viscosity_linear=visc.linear, bulk_viscosity_quadratic=visc.quadratic)
     if fine_model.backend == "numba":
         from ..models.j2_kernel import warm_up
+        from ..models.j2_kernel_3d import warm_up_solid
 
-        warm_up()  # compile (or load) the kernel before the clock starts
+        # compile (or load) before the clock starts
+        warm_up_solid() if geometry == "3d" else warm_up()
     v0 = bar.initial_velocity(velocity)
     ke0 = 0.5 * float(v0 @ (bar.lumped_mass() * v0))
     frames = np.arange(0.0, t_end * (1 + 1e-12), frame_interval)
@@ -402,7 +409,7 @@ def run_taylor_bar(
     u = res.u
     state = res.states[bar.fine_block][0]
     ip = int(np.argmax(state.eqps))
-    xq = fine_model.quadrature_points().reshape(2, -1)[:, ip]
+    xq = fine_model.quadrature_points().reshape(bar.fine_mesh.dim(), -1)[:, ip]
     steps = np.asarray(res.step_sizes if res.step_sizes is not None else [res.dt])
     n_qp = state.eqps.size
     hist = rec.history
@@ -420,7 +427,7 @@ def run_taylor_bar(
         history=hist,
         elements_radial=n_r,
         elements_axial=n_z,
-        max_plastic_strain_at=[float(xq[0]), float(xq[1])],
+        max_plastic_strain_at=[float(x) for x in xq],
         initial_kinetic_energy=ke0,
         impact_loss=hist["contact_work"][0],
         fixed_point_iterations=rec.iteration_summary(),
@@ -441,7 +448,7 @@ def run_taylor_bar(
             "patch_length": sizes.patch_length,
         }  # fmt: skip
     if arlequin:
-        assert isinstance(bar, ArlequinBar) and lam_history is not None
+        assert isinstance(bar, (ArlequinBar, ArlequinBar3D)) and lam_history is not None
         s = bar.sizes
         band_eqps = bar.band_plastic_strain(state)
         chatter = lam_history.chatter()

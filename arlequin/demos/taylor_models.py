@@ -126,7 +126,7 @@ class MonoBar:
                  friction: float = 0.0) -> None:  # fmt: skip
         if mesh is None:
             mesh = taylor_bar_mesh(length, radius, elements_radial)
-        self.mesh = mesh
+        self.mesh = self.fine_mesh = mesh
         self.model = FiniteStrainJ2(mesh, material, "axisymmetric", fbar, backend=backend,
                                     bulk_viscosity=bulk_viscosity)  # fmt: skip
         bar = self.model

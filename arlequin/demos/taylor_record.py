@@ -228,6 +228,7 @@ def write_results(folder: ResultsFolder, result: Any, units: dict[str, str]) -> 
     plot_taylor_bar(result, str(folder.picture("taylor_bar_history")))
     title = (f"t = {result.history['t'][-1] * 1e6:.1f} us: length {result.final_length * 1e3:.2f} "
              f"mm, footprint radius {result.mushroom_radius * 1e3:.2f} mm"
-             + ("" if result.arlequin else " (grey: initial shape)"))  # fmt: skip
+             + ("" if result.arlequin or result.config.get("geometry") == "3d"
+                else " (grey: initial shape)"))  # fmt: skip
     result.setup.render(result.u, result.state, str(folder.picture("taylor_bar")), title)
     folder.finish()

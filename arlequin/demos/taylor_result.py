@@ -13,6 +13,7 @@ from ..io.folder import jsonable
 
 __all__ = [
     "ARLEQUIN_JSON_KEYS",
+    "GEOMETRIES",
     "JSON_KEYS",
     "MODELS",
     "TAYLOR_REFERENCE",
@@ -39,6 +40,9 @@ ARLEQUIN_JSON_KEYS = ("coarse_elements", "fine_elements", "coarse_size", "fine_s
 
 #: The models of the bar.
 MODELS = ("arlequin", "mono", "graded")
+
+#: The bar's geometries: the (r, z) section, or the quarter bar of hexahedra.
+GEOMETRIES = ("axisymmetric", "3d")
 
 
 class GluingBandPlasticityWarning(UserWarning):
