@@ -18,6 +18,13 @@ three quantities of interest of each and the process's peak memory after each ru
 
     python benchmarks/taylor_bar.py [--levels 5 10 20 30] [--plain 10 20] [--window 1e-6]
     python benchmarks/taylor_bar.py --compare 20 [--coarse-step-ratio 4]
+    python benchmarks/taylor_bar.py --geometry 3d --levels 4 6 8 --plain
+    python benchmarks/taylor_bar.py --geometry 3d --compare 8 [--patch-length LP]
+
+``--geometry 3d``: the quarter bar of hexahedra. There the uniform reference of ``--compare`` is
+the single mesh with the patch's nodes (``--model mono --coarse-size``: the coarse O-grid
+refined), and the graded mesh has three sheets of 2:1 transition templates
+(:mod:`arlequin.demos.taylor_graded_3d`).
 
 With ``--coarse-step-ratio M`` the Arlequin bar is also run with the multi-time-step scheme
 (the coarse model's force every m ≤ M fine steps): its wall time, the gain over the one-step
@@ -33,16 +40,17 @@ import subprocess
 import sys
 
 
-def one_level(n: int, fbar: bool, window: float) -> dict:
+def one_level(n: int, fbar: bool, window: float, geometry: str = "axisymmetric") -> dict:
     from arlequin.demos.taylor_bar import TAYLOR_REFERENCE, run_taylor_bar
 
-    r = run_taylor_bar(model="mono", elements_radial=n, fbar=fbar)
+    r = run_taylor_bar(model="mono", elements_radial=n, fbar=fbar, geometry=geometry)
     ref = TAYLOR_REFERENCE
     record = {
         "elements_radial": n,
+        "geometry": geometry,
         "fbar": fbar,
         "elements": r.n_elements,
-        "quadrature_points": 4 * r.n_elements,
+        "quadrature_points": int(r.state.eqps.size),
         "steps": r.n_steps,
         "wall_time_s": round(r.wall_time_s, 2),
         "setup_time_s": round(r.setup_time_s, 2),
@@ -59,8 +67,9 @@ def one_level(n: int, fbar: bool, window: float) -> dict:
     }
     if fbar and window > 0:
         # the same mesh and window with both backends: the loop time ratio
-        fast = run_taylor_bar(model="mono", elements_radial=n, t_end=window, backend="numba")
-        slow = run_taylor_bar(model="mono", elements_radial=n, t_end=window, backend="numpy")
+        kw = dict(model="mono", elements_radial=n, t_end=window, geometry=geometry)
+        fast = run_taylor_bar(backend="numba", **kw)
+        slow = run_taylor_bar(backend="numpy", **kw)
         assert fast.n_steps == slow.n_steps
         loop = [x.wall_time_s - x.setup_time_s for x in (slow, fast)]
         record["numpy_numba_ratio"] = round(loop[0] / loop[1], 2)
@@ -83,21 +92,28 @@ def _qoi(r) -> dict:
     }
 
 
-def compare(n: int, coarse_size: float | None = None, ratio_mts: int = 1) -> dict:
+def compare(n: int, coarse_size: float | None = None, ratio_mts: int = 1,
+            geometry: str = "axisymmetric", patch_length: float | None = None) -> dict:  # fmt: skip
     """Arlequin against the uniform fine mesh, in this process (see the module docstring)."""
     import warnings
 
     from arlequin.demos.taylor_bar import GluingBandPlasticityWarning, run_taylor_bar
 
+    three_d = geometry == "3d"
+    common = dict(elements_radial=n, geometry=geometry)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", GluingBandPlasticityWarning)
-        arl = run_taylor_bar(model="arlequin", elements_radial=n, coarse_size=coarse_size)
+        arl = run_taylor_bar(model="arlequin", coarse_size=coarse_size,
+                             patch_length=patch_length, **common)  # fmt: skip
     mts = None
     if ratio_mts > 1:
-        mts = run_taylor_bar(model="arlequin", elements_radial=n, coarse_size=coarse_size,
-                             coarse_step_ratio=ratio_mts)  # fmt: skip
-    uni = run_taylor_bar(model="mono", elements_radial=n)
-    graded = run_taylor_bar(model="graded", elements_radial=n)
+        mts = run_taylor_bar(model="arlequin", coarse_size=coarse_size, patch_length=patch_length,
+                             coarse_step_ratio=ratio_mts, **common)  # fmt: skip
+    # 3D: the single mesh with the patch's nodes (the coarse O-grid refined)
+    uni = run_taylor_bar(model="mono", coarse_size=arl.arlequin["coarse_size"] if three_d
+                         else None, **common)  # fmt: skip
+    graded = run_taylor_bar(model="graded", coarse_size=coarse_size, patch_length=patch_length,
+                            **common)  # fmt: skip
     a = arl.arlequin
     p = a["patch_fraction"]
     ratio = arl.wall_time_s / uni.wall_time_s
@@ -108,19 +124,24 @@ def compare(n: int, coarse_size: float | None = None, ratio_mts: int = 1) -> dic
         "arlequin": {**_qoi(arl), **{k: a[k] for k in ("coarse_elements", "fine_elements",
                      "band_max_plastic_strain", "multiplier_chatter_per_row")},
                      "band_warning": bool(caught)},
+        "geometry": geometry,
         "uniform": _qoi(uni),
-        "graded": _qoi(graded),
+        "graded": None if graded is None else _qoi(graded),
         "time_ratio_arlequin_uniform": round(ratio, 4),
         "time_bound_(1+p)/2": round((1 + p) / 2, 4),
-        "time_ratio_arlequin_graded": round(arl.wall_time_s / graded.wall_time_s, 4),
         "time_bound_graded": 1.3,
-        "graded_length_difference": round(graded.final_length / uni.final_length - 1, 5),
-        "graded_radius_difference": round(graded.mushroom_radius / uni.mushroom_radius - 1, 5),
         "length_difference": round(arl.final_length / uni.final_length - 1, 5),
         "radius_difference": round(arl.mushroom_radius / uni.mushroom_radius - 1, 5),
         "max_plastic_strain_difference": round(arl.max_plastic_strain / uni.max_plastic_strain
                                                - 1, 5),
     }  # fmt: skip
+    if graded is not None:
+        out.update({
+            "time_ratio_arlequin_graded": round(arl.wall_time_s / graded.wall_time_s, 4),
+            "graded_length_difference": round(graded.final_length / uni.final_length - 1, 5),
+            "graded_radius_difference": round(graded.mushroom_radius / uni.mushroom_radius - 1,
+                                              5),
+        })  # fmt: skip
     if mts is not None:
         m = mts.arlequin
         out["multi_time_step"] = {
@@ -148,27 +169,34 @@ def main(argv: list[str] | None = None) -> int:
                         help="with --compare: the Arlequin coarse size (m)")  # fmt: skip
     parser.add_argument("--coarse-step-ratio", type=int, default=1, metavar="M",
                         help="with --compare: also the Arlequin run with multi-time-step M")
+    parser.add_argument("--geometry", choices=["axisymmetric", "3d"], default="axisymmetric")
+    parser.add_argument("--patch-length", type=float, default=None,
+                        help="with --compare: the Arlequin patch length (m)")  # fmt: skip
     parser.add_argument("--single", type=int, default=None, help=argparse.SUPPRESS)
     parser.add_argument("--no-fbar", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.compare is not None:
         from arlequin.models.j2_kernel import warm_up
+        from arlequin.models.j2_kernel_3d import warm_up_solid
 
-        warm_up()
-        out = compare(args.compare, args.coarse_size, args.coarse_step_ratio)
+        warm_up_solid() if args.geometry == "3d" else warm_up()
+        out = compare(args.compare, args.coarse_size, args.coarse_step_ratio, args.geometry,
+                      args.patch_length)  # fmt: skip
         print(json.dumps({"benchmark": "taylor_bar_compare", **out}, indent=2))
         return 0
     if args.single is not None:
-        print(json.dumps(one_level(args.single, not args.no_fbar, args.window)))
+        print(json.dumps(one_level(args.single, not args.no_fbar, args.window, args.geometry)))
         return 0
     # compile (or load) the kernel once, outside every measurement
     from arlequin.models.j2_kernel import warm_up
+    from arlequin.models.j2_kernel_3d import warm_up_solid
 
-    warm_up()
+    warm_up_solid() if args.geometry == "3d" else warm_up()
     records = []
     runs = [(n, True) for n in args.levels] + [(n, False) for n in args.plain]
     for n, fbar in runs:
-        cmd = [sys.executable, __file__, "--single", str(n), "--window", str(args.window)]
+        cmd = [sys.executable, __file__, "--single", str(n), "--window", str(args.window),
+               "--geometry", args.geometry]  # fmt: skip
         if not fbar:
             cmd.append("--no-fbar")
         out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout

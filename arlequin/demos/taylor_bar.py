@@ -441,7 +441,7 @@ def run_taylor_bar(
         setup=bar,
     )
     if model == "graded":
-        fine_cells = 2 * sizes.coarse_radial * 2 * sizes.patch_rows
+        fine_cells = bar.graded_fine_elements
         result.arlequin = {
             "coarse_elements": bar.n_elements - fine_cells, "fine_elements": fine_cells,
             "coarse_size": sizes.coarse_size, "fine_size": sizes.fine_size,

@@ -34,6 +34,7 @@ __all__ = [
     "quarter_bar_mesh",
     "quarter_section_counts",
     "refined_bar_mesh",
+    "section_blocks",
 ]
 
 #: a = R/2 (the inner block's corner at (a, a)) and the bulge β of its curved edges.
@@ -100,6 +101,17 @@ def _outer(t: np.ndarray, s: np.ndarray, radius: float) -> np.ndarray:
     return (1 - t) * _curve(s, radius) + t * arc
 
 
+def section_blocks(radius: float, n_s: int, n_o: int) -> tuple:
+    """The O-grid's three blocks: ((cells along the first and second parameter), map
+    (u, w) ∈ [0, 1]² -> (x, y)) for the inner block (u ~ x, w ~ y), the outer block next to the
+    x axis (u radial, w tangential) and its mirror image (u tangential, w radial)."""
+    return (
+        ((n_s, n_s), lambda u, w: _inner(u, w, radius)),
+        ((n_o, n_s), lambda u, w: _outer(u, w, radius)),
+        ((n_s, n_o), lambda u, w: _outer(w, u, radius)[::-1]),  # mirror: orientation kept
+    )
+
+
 def quarter_bar_mesh(length: float, radius: float, elements_radial: int,
                      elements_axial: int | None = None) -> skfem.MeshHex:  # fmt: skip
     """The quarter bar x, y ≥ 0, z ∈ [0, L] on the O-grid section (module docstring).
@@ -122,13 +134,8 @@ def quarter_bar_mesh(length: float, radius: float, elements_radial: int,
     n_z = max(1, round(length * elements_radial / radius)) if elements_axial is None \
         else int(elements_axial)  # fmt: skip
     z = np.linspace(0.0, length, n_z + 1)
-    blocks = (  # (counts along the two parameters, map to (x, y))
-        ((n_s, n_s), lambda u, w: _inner(u, w, radius)),
-        ((n_o, n_s), lambda u, w: _outer(u, w, radius)),
-        ((n_s, n_o), lambda u, w: _outer(w, u, radius)[::-1]),  # mirror: orientation kept
-    )
     points, cells, offset = [], [], 0
-    for (c1, c2), to_xy in blocks:
+    for (c1, c2), to_xy in section_blocks(radius, n_s, n_o):
         grid = skfem.MeshHex.init_tensor(np.linspace(0, 1, c1 + 1), np.linspace(0, 1, c2 + 1), z)
         xy = to_xy(grid.p[0], grid.p[1])
         points.append(np.vstack([xy, grid.p[2]]))

@@ -120,6 +120,8 @@ class MonoBar:
     """
 
     fine_block = "bar"
+    #: the fine cells of a graded mesh (set when the mesh is one; None for a uniform mesh)
+    graded_fine_elements: int | None = None
 
     def __init__(self, length, radius, elements_radial, material: J2Material, fbar=True,
                  backend="auto", bulk_viscosity=None, mesh=None,

@@ -8,8 +8,14 @@ from __future__ import annotations
 from typing import Any
 
 from ..models import J2Material
+from .taylor_graded_3d import graded_bar_mesh_3d
 from .taylor_meshes import ArlequinBarSizes, arlequin_bar_sizes, graded_bar_mesh
-from .taylor_meshes_3d import patch_levels, quarter_bar_mesh, refined_bar_mesh
+from .taylor_meshes_3d import (
+    patch_levels,
+    quarter_bar_mesh,
+    quarter_section_counts,
+    refined_bar_mesh,
+)
 from .taylor_models import ArlequinBar, MonoBar
 from .taylor_models_3d import ArlequinBar3D, MonoBar3D
 from .taylor_result import GEOMETRIES
@@ -38,10 +44,6 @@ def build_bar(
     if patch_surface is not None and not (three_d and model == "arlequin"):
         raise ValueError(f"patch_surface applies to model='arlequin' with geometry='3d' only, "
                          f"got model={model!r}, geometry={geometry!r}")  # fmt: skip
-    if three_d and model == "graded":
-        raise ValueError("model='graded' is axisymmetric only: the O-grid section of the 3D bar "
-                         "has no conforming 2:1 hexahedral transition here; compare the 3D "
-                         "Arlequin bar with model='mono' at the patch's resolution")  # fmt: skip
     if three_d and model == "mono" and patch_length is not None:
         raise ValueError(f"patch_length applies to model='arlequin' only, got model={model!r}")
     sizes = None
@@ -50,9 +52,17 @@ def build_bar(
         config.update(sizes.as_dict())
     solid = dict(fbar=fbar, backend=backend, bulk_viscosity=bulk_viscosity, friction=friction)
     if model == "graded":
-        mesh = graded_bar_mesh(length, radius, sizes)
-        return MonoBar(length, radius, n_r, material, mesh=mesh, **solid), \
-            2 * sizes.patch_rows, sizes  # fmt: skip
+        if three_d:
+            mesh = graded_bar_mesh_3d(length, radius, sizes)
+            bar = MonoBar3D(length, radius, n_r, material, mesh=mesh, **solid)
+            n_s, n_o = quarter_section_counts(sizes.coarse_radial)
+            per_layer = n_s * n_s + 2 * n_s * n_o
+            bar.graded_fine_elements = 8 * per_layer * sizes.patch_rows
+        else:
+            mesh = graded_bar_mesh(length, radius, sizes)
+            bar = MonoBar(length, radius, n_r, material, mesh=mesh, **solid)
+            bar.graded_fine_elements = 2 * sizes.coarse_radial * 2 * sizes.patch_rows
+        return bar, 2 * sizes.patch_rows, sizes
     if model == "arlequin":
         options = dict(weights=weights, mediator=mediator, coupling=coupling, **solid)
         if three_d:
