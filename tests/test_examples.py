@@ -42,6 +42,22 @@ def test_arlequin_taylor_bar_tutorial_is_the_demo():
     assert out["mushroom_radius"] == pytest.approx(demo.mushroom_radius, rel=1e-12)
 
 
+def test_taylor_bar_3d_tutorial_is_the_demo(tmp_path):
+    # the 3D tutorial (its patch from a closed surface) builds with the public API what
+    # run_taylor_bar(geometry="3d", patch_surface=...) builds: the same steps and answer
+    from arlequin.demos import run_taylor_bar
+
+    example = load("taylor_bar_3d")
+    stl = tmp_path / "patch.stl"
+    example.patch_box(0.5 * 32.4e-3).export(stl)
+    out = example.run(fine_radial=8, t_end=2e-6, surface=str(stl))
+    demo = run_taylor_bar(geometry="3d", elements_radial=8, t_end=2e-6, patch_surface=str(stl))
+    assert out["n_steps"] == demo.n_steps
+    assert out["fine_elements"] == demo.arlequin["fine_elements"]
+    assert out["final_length"] == pytest.approx(demo.final_length, rel=1e-12)
+    assert out["mushroom_radius"] == pytest.approx(demo.mushroom_radius, rel=1e-12)
+
+
 def test_two_bars_example_runs_small(tmp_path):
     # the figures of docs/contact.md at a small size; the picture goes where it is asked to
     out = load("two_bars").run(elements=20, refinement=(20, 40), blocks=False,
@@ -53,7 +69,8 @@ def test_two_bars_example_runs_small(tmp_path):
 
 
 # every example is run by the suite: the guard fails when a new one is not
-COVERED = {"refined_patch", "arlequin_taylor_bar", "two_bars", "plate_with_hole", "ball_on_block"}
+COVERED = {"refined_patch", "arlequin_taylor_bar", "two_bars", "plate_with_hole", "ball_on_block",
+           "taylor_bar_3d"}
 
 
 def test_every_example_is_covered():

@@ -29,9 +29,11 @@ def _interrupt_at(t_stop: float):
     return progress
 
 
-@pytest.mark.parametrize("model", ["arlequin", "mono"])
-def test_resumed_run_equals_the_uninterrupted_one(model, tmp_path):
-    kw = {"model": model, "elements_radial": 4, "t_end": 8e-6, "checkpoint_interval": 2e-6}
+@pytest.mark.parametrize(("model", "geometry"), [("arlequin", "axisymmetric"),
+                                                ("mono", "axisymmetric"), ("mono", "3d")])
+def test_resumed_run_equals_the_uninterrupted_one(model, geometry, tmp_path):
+    kw = {"model": model, "elements_radial": 4, "t_end": 8e-6, "checkpoint_interval": 2e-6,
+          "geometry": geometry}  # fmt: skip
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the band warning of so coarse a patch
         whole = run_taylor_bar(out=tmp_path / "whole", **kw)
