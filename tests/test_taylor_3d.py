@@ -217,9 +217,10 @@ def test_patch_surface_selects_the_same_patch_bit_for_bit(tmp_path):
     box.export(stl)
     kw = dict(geometry="3d", elements_radial=8, t_end=1e-6)
     a = run_taylor_bar("arlequin", patch_length=lp, **kw)
-    b = run_taylor_bar("arlequin", patch_length=lp, patch_surface=str(stl), **kw)
+    b = run_taylor_bar("arlequin", patch_surface=str(stl), **kw)
     assert np.array_equal(a.setup.patch_cells, b.setup.patch_cells)
     assert np.array_equal(a.u, b.u)
+    assert b.arlequin["patch_length"] == pytest.approx(a.arlequin["patch_length"], rel=1e-12)
 
 
 @pytest.mark.parametrize(
@@ -228,6 +229,7 @@ def test_patch_surface_selects_the_same_patch_bit_for_bit(tmp_path):
         ({"model": "graded", "elements_radial": 10}, "use 4, 6, 10, 14 or 16 across"),
         ({"model": "mono", "patch_surface": "x.stl"}, "patch_surface applies to"),
         ({"model": "mono", "patch_length": 0.01}, "patch_length"),
+        ({"model": "arlequin", "patch_length": 0.01, "patch_surface": "a.stl"}, "not both"),
         ({"model": "mono", "elements_radial": 1}, "at least 2 cells across the radius"),
         ({"model": "arlequin", "elements_radial": 12, "coarse_size": 3 * R / 12}, "power-of-two"),
         ({"model": "arlequin", "elements_radial": 4}, "at least 4 coarse cells"),

@@ -455,7 +455,8 @@ def run_taylor_bar(
         result.arlequin = {
             "coarse_elements": bar.coarse_elements, "fine_elements": bar.fine_elements,
             "coarse_size": s.coarse_size, "fine_size": s.fine_size,
-            "patch_fraction": bar.patch_fraction, "patch_length": s.patch_length,
+            "patch_fraction": bar.patch_fraction,
+            "patch_length": getattr(bar, "patch_top", s.patch_length),
             "gluing_width": s.gluing_width, "band_max_plastic_strain": band_eqps,
             "multiplier_chatter": chatter["global"],
             "multiplier_chatter_per_row": chatter["per_row"],

@@ -268,7 +268,9 @@ class ArlequinBar3D(_Quarter):
         cp = cmesh.p
         self.band_cells = self.coupling.fine_gluing_cells
         z_cells = cp[2, cmesh.t].max(axis=0)
-        self.drawn_coarse_cells = np.nonzero(z_cells > s.patch_length - s.gluing_width + tol_z)[0]
+        #: the top of the patch (m): its highest coarse node (patch_length unless a surface)
+        self.patch_top = float(cp[2, cmesh.t[:, cells]].max())
+        self.drawn_coarse_cells = np.nonzero(z_cells > z_out - s.gluing_width + tol_z)[0]
         self.n_elements = int(cmesh.nelements + fmesh.nelements)
         self.coarse_elements = int(cmesh.nelements)
         self.fine_elements = int(fmesh.nelements)

@@ -44,6 +44,9 @@ def build_bar(
     if patch_surface is not None and not (three_d and model == "arlequin"):
         raise ValueError(f"patch_surface applies to model='arlequin' with geometry='3d' only, "
                          f"got model={model!r}, geometry={geometry!r}")  # fmt: skip
+    if patch_surface is not None and patch_length is not None:
+        raise ValueError(f"give patch_length or patch_surface, not both (got "
+                         f"patch_length={patch_length}, patch_surface={patch_surface!r})")
     if three_d and model == "mono" and patch_length is not None:
         raise ValueError(f"patch_length applies to model='arlequin' only, got model={model!r}")
     sizes = None
@@ -69,6 +72,7 @@ def build_bar(
             config.update(patch_surface=None if patch_surface is None else str(patch_surface))
             bar: Any = ArlequinBar3D(length, radius, sizes, material, surface=patch_surface,
                                      **options)  # fmt: skip
+            config["patch_length"] = bar.patch_top  # the surface's patch reaches this high
         else:
             bar = ArlequinBar(length, radius, sizes, material, **options)
         return bar, sizes.patch_rows * sizes.ratio, sizes
