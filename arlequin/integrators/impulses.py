@@ -8,12 +8,11 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-import scipy.linalg as sla
 import scipy.sparse as sp
 
 from ..contract import ConstraintError
-from .linalg import factor_checked, factor_rows
-from .rows import rows_key
+from .linalg import dense_cho_factor, dense_cho_solve, factor_checked, factor_rows
+from .rows import rows_key, transposed
 
 __all__ = ["ImpulseSolver"]
 
@@ -105,7 +104,8 @@ class ImpulseSolver:
         if m_a <= self._DENSE_SCHUR:
 
             def build_schur():
-                s_aa = (ga_m @ g_a.T).tocsr()
+                # G_Aᵀ from the shared cache: the integrator applies it to Λ_A right after
+                s_aa = (ga_m @ transposed(g_a)).tocsr()
                 # only the active rows that share a dof with the equality rows have a non-zero
                 # column in (B M⁻¹ G_Aᵀ): solve for those alone (a few near a symmetry axis)
                 coupled = np.nonzero(np.diff(s_ae.indptr))[0]
@@ -115,7 +115,7 @@ class ImpulseSolver:
                 if coupled.size:
                     schur[:, coupled] -= s_ae @ x
                 try:
-                    cho = sla.cho_factor(schur)
+                    cho = dense_cho_factor(schur)
                 except np.linalg.LinAlgError as exc:
                     raise ConstraintError(
                         "active unilateral rows are dependent on each other or on the equality "
@@ -125,7 +125,7 @@ class ImpulseSolver:
 
             coupled, x, cho = self._cached(key, build_schur)
             y = self.lu.solve(r_e)
-            lam_a = sla.cho_solve(cho, r_a - s_ae @ y)
+            lam_a = dense_cho_solve(cho, r_a - s_ae @ y)
             if coupled.size:
                 y = y - x @ lam_a[coupled]
             return y, lam_a
