@@ -75,7 +75,9 @@ def stack_active(trials: Sequence, n: int, cache: dict | None = None):
     key = tuple((id(tr.matrix), tr.active.tobytes()) for tr in trials)
     if cache is not None and cache.get("key") == key:
         return cache["g_a"], np.concatenate(rhs), idx
-    g_a = _stack_rows([sp.csr_matrix(tr.matrix) for tr in trials], idx, n)
+    mats = [tr.matrix if getattr(tr.matrix, "format", None) == "csr" else
+            sp.csr_matrix(tr.matrix) for tr in trials]  # fmt: skip
+    g_a = _stack_rows(mats, idx, n)
     if cache is not None:
         # the matrices are kept alive with the key so that their ids cannot be reused
         cache.clear()
