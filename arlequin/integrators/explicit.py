@@ -49,7 +49,7 @@ from .controllers import FixedStep, StepController
 from .damping import RayleighDamping
 from .impulses import ImpulseSolver
 from .registry import register
-from .rows import transposed, unilateral_block_power
+from .rows import transposed, unilateral_block_powers
 from .stability import DEFAULT_SAFETY, StableStep, check_time_step, stable_time_step
 
 __all__ = ["DEFAULT_SAFETY", "CentralDifference"]
@@ -341,32 +341,29 @@ class CentralDifference(Integrator):
     def _powers(self, v: np.ndarray, v2: np.ndarray | None = None):
         """External, coupling, other-constraint and damping powers per block (W) of the forces
         at the current time with the velocity v (m/s): a tuple of four (n_blocks,) arrays; with
-        a second velocity v2, the pair of those tuples (the equality rows' in one pass)."""
-        if v2 is None:
-            pc_po = self.rows.block_powers(self._lam_e / self._dt_bar, v[self.rows.cols]) \
-                if self.rows.m else None  # fmt: skip
-            return self._powers_with(v, pc_po)
-        if not self.rows.m:
-            return self._powers_with(v, None), self._powers_with(v2, None)
-        cols = self.rows.cols
-        first, second = self.rows.block_powers_pair(self._lam_e / self._dt_bar, v[cols], v2[cols])
-        return self._powers_with(v, first), self._powers_with(v2, second)
-
-    def _powers_with(self, v: np.ndarray, pc_po) -> tuple[np.ndarray, ...]:
-        """:meth:`_powers` for v given the equality rows' (coupling, other) powers."""
+        a second velocity v2, the pair of those tuples (the constraint forces computed once)."""
+        vs = (v,) if v2 is None else (v, v2)
         nb = len(self.ops.blocks)
-        p_ext = self.ops.block_dots(self._f_ext, v) if self._f_ext is not None else np.zeros(nb)
-        if pc_po is not None:
-            pc, po = pc_po
+        if self.rows.m:
+            cols = self.rows.cols
+            eq = self.rows.block_powers_of(self._lam_e / self._dt_bar, [x[cols] for x in vs])
         else:
-            pc, po = np.zeros(nb), np.zeros(nb)
-        if self._g_a.shape[0]:
-            po = po + unilateral_block_power(self.ops, self._g_a, self._lam_a / self._dt_bar, v)
-        if self._f_applied is not None:  # slip friction
-            po = po + self.ops.block_dots(self._f_applied, v)
-        if self._f_damp is None:
-            return p_ext, pc, po, np.zeros(nb)
-        return p_ext, pc, po, -self.ops.block_dots(self._f_damp, v)
+            eq = [(np.zeros(nb), np.zeros(nb)) for _ in vs]
+        uni = unilateral_block_powers(self.ops, self._g_a, self._lam_a / self._dt_bar, vs) \
+            if self._g_a.shape[0] else None  # fmt: skip
+        out = []
+        for i, x in enumerate(vs):
+            pc, po = eq[i]
+            if uni is not None:
+                po = po + uni[i]
+            p_ext = self.ops.block_dots(self._f_ext, x) if self._f_ext is not None else \
+                np.zeros(nb)  # fmt: skip
+            if self._f_applied is not None:  # slip friction
+                po = po + self.ops.block_dots(self._f_applied, x)
+            p_damp = np.zeros(nb) if self._f_damp is None else \
+                -self.ops.block_dots(self._f_damp, x)  # fmt: skip
+            out.append((p_ext, pc, po, p_damp))
+        return out[0] if v2 is None else (out[0], out[1])
 
     def _damping_force(self, v: np.ndarray) -> np.ndarray | None:
         """C v (N) with the mid-step velocity v that precedes the force's time, or None."""

@@ -30,6 +30,7 @@ __all__ = [
     "stack_active",
     "transposed",
     "unilateral_block_power",
+    "unilateral_block_powers",
 ]
 
 
@@ -144,6 +145,20 @@ def unilateral_block_power(
     return -ops.block_dots(transposed(g) @ lam, x)
 
 
+def unilateral_block_powers(
+    ops: SystemOperators, g: sp.csr_matrix, lam: np.ndarray, xs: Sequence[np.ndarray]
+) -> list[np.ndarray]:
+    """:func:`unilateral_block_power` for several vectors x, on the dofs the rows touch only
+    (the same powers up to round-off: the force Gᵀλ is summed on those dofs alone)."""
+    nb = len(ops.blocks)
+    if g.shape[0] == 0:
+        return [np.zeros(nb) for _ in xs]
+    cols, inv = np.unique(g.indices, return_inverse=True)
+    force = np.bincount(inv, g.data * np.repeat(lam, np.diff(g.indptr)), minlength=cols.size)
+    block = ops.block_of_dof[cols]
+    return [-np.bincount(block, force * x[cols], minlength=nb) for x in xs]
+
+
 def _rate(c: LinearConstraint, t: float, h: float, order: int = 1) -> np.ndarray:
     """d^order g / dt^order by centred differences with step h (zero for constant data)."""
     if not callable(c.rhs):
@@ -207,6 +222,7 @@ class EqualityRows:
                 shape=(self.n_blocks * self.m, self.cols.size),
             )
         self._coupling_f = self.coupling.astype(float)
+        self._by_kind: list[tuple[np.ndarray, sp.csr_matrix]] | None = None
         self._constant = all(not callable(c.rhs) for c in self.constraints)
         self._g0 = self._g(0.0) if self._constant else None
 
@@ -251,25 +267,30 @@ class EqualityRows:
         nb = self.n_blocks
         if self.m == 0:
             return np.zeros(nb), np.zeros(nb)
-        return self._powers_of(self._stacked @ x_cols, lam)
-
-    def block_powers_pair(
-        self, lam: np.ndarray, x_cols: np.ndarray, y_cols: np.ndarray
-    ) -> tuple[tuple[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]:
-        """:meth:`block_powers` for two vectors x and y with the same multipliers, the same
-        numbers bit for bit, in one pass over the stacked rows (a product with two columns sums
-        each one in the order of the product with one)."""
-        nb = self.n_blocks
-        if self.m == 0:
-            return (np.zeros(nb), np.zeros(nb)), (np.zeros(nb), np.zeros(nb))
-        both = (self._stacked @ np.column_stack([x_cols, y_cols])).T.copy()
-        return self._powers_of(both[0], lam), self._powers_of(both[1], lam)
-
-    def _powers_of(self, bx: np.ndarray, lam: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        rb = bx.reshape(self.n_blocks, self.m) * lam
+        rb = (self._stacked @ x_cols).reshape(nb, self.m) * lam
         pc = -(rb * self._coupling_f).sum(axis=1)
         po = -rb.sum(axis=1) - pc
         return pc, po
+
+    def block_powers_of(
+        self, lam: np.ndarray, xs: Sequence[np.ndarray]
+    ) -> list[tuple[np.ndarray, np.ndarray]]:
+        """:meth:`block_powers` for several vectors x (on :attr:`cols`) with the same
+        multipliers, from the forces: ``−Σ_{j∈b} x_j (B_cᵀλ_c)_j`` and the same with the other
+        rows. The forces are computed once, then each x costs a product and a sum over the
+        touched dofs (the stacked rows' products, twice a step, cost 6% of an explicit step);
+        the same powers as :meth:`block_powers` up to round-off (the order of the sums)."""
+        nb = self.n_blocks
+        if self.m == 0:
+            return [(np.zeros(nb), np.zeros(nb)) for _ in xs]
+        if self._by_kind is None:
+            # Bᵀ of the coupling rows and of the others, apart (made on first use)
+            kinds = (np.nonzero(self.coupling)[0], np.nonzero(~self.coupling)[0])
+            self._by_kind = [(r, self.matrix_cols[r].T.tocsr()) for r in kinds]
+        f_c, f_o = (bt @ lam[r] for r, bt in self._by_kind)
+        boc = self.block_of_col
+        return [(-np.bincount(boc, f_c * x, minlength=nb), -np.bincount(boc, f_o * x, minlength=nb))
+                for x in xs]  # fmt: skip
 
     def row_name(self, i: int) -> str:
         """Description of stacked row ``i`` for error messages."""
