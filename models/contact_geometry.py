@@ -350,8 +350,9 @@ def _rows_by_point(vals: np.ndarray, cols: np.ndarray, n: int) -> sp.csr_matrix 
     """CSR rows with the entries ``vals`` (m, w) in the columns ``cols`` (m, w), row by row.
 
     The arrays of ``sp.csr_matrix((vals, (rows, cols)))`` (columns sorted in each row, explicit
-    zeros kept) without its COO conversion and duplicate summation, a fifth of a contact step;
-    None if a row has a column twice (the caller sums them by COO).
+    zeros kept) without its COO conversion and duplicate summation (the deformable pair's
+    geometry took 150 µs a step with them, 110 without, at 26 points); None if a row has a
+    column twice (the caller sums them by COO).
     """
     order = np.argsort(cols, axis=1)
     cols = np.take_along_axis(cols, order, axis=1)

@@ -323,7 +323,8 @@ class CentralDifference(Integrator):
         # step starts, since a new step size at t changes the forces at t.
         half = 0.5 * dt_prev
         # the powers of these forces with v^{n+1/2} too, which the next step needs (_step_impl):
-        # both in one pass over the rows, kept with v^{n+1/2} itself (never modified in place)
+        # the constraint forces computed once for both, kept with v^{n+1/2} itself (never
+        # modified in place; a restored run recomputes them, to the same numbers)
         p_now, p_next = self._powers(v_minus, v_next)
         self._p_next = (v_next, p_next)
         self._w_pending = tuple(half * (p + q) for p, q in zip(self._p_prev, p_now))
