@@ -131,6 +131,7 @@ class ContactSurface:
             r = mesh.p[0, fn]  # (n_f, 2)
             contrib = (2.0 * np.pi * meas[:, None] * (2.0 * r + r[:, ::-1]) / 6.0).ravel()
         self.weights = np.bincount(inv, contrib, minlength=nodes.size)
+        self._dofs = self.node_dofs(nodes)  # (dim, m): the pairs' geometry needs them each step
 
     @property
     def n_points(self) -> int:
@@ -142,7 +143,9 @@ class ContactSurface:
 
     def positions(self, u: np.ndarray, nodes: np.ndarray | None = None) -> np.ndarray:
         """Current positions X + u of mesh nodes (default: surface nodes), shape (dim, k) (m)."""
-        nodes = self.nodes if nodes is None else np.asarray(nodes, dtype=np.int64)
+        if nodes is None:
+            return self.mesh.p[:, self.nodes] + u[self._dofs]
+        nodes = np.asarray(nodes, dtype=np.int64)
         return self.mesh.p[:, nodes] + u[self.node_dofs(nodes)]
 
 
@@ -280,12 +283,21 @@ class DeformableContactPair(ContactPair):
             self._tris, self._orient = tri, orient
         else:
             self._tris, self._orient = fn, master._orient
+        # per-step index arrays that depend on the reference configuration only
+        nt, nv = self._tris.shape
+        self._tri_dofs = master.node_dofs(self._tris.ravel())  # (dim, n_t·n_v)
+        self._tri_dofs_by_point = self._tri_dofs.T.reshape(nt, nv, master.dim)
+        self._tri_p = master.mesh.p[:, self._tris]  # (dim, n_t, n_v)
+        m, d = slave.n_points, slave.dim
+        self._r_s = np.repeat(np.arange(m), d)
+        self._c_s = slave._dofs.T.ravel()
+        self._r_m = np.repeat(np.arange(m), nv * d)
 
     def _project(self, xs: np.ndarray, u: np.ndarray):
         """Closest master facet of each slave point: (facet, shape values (m, n_v), x_m, normal)."""
         master = self.master
         fn = self._tris
-        xf = master.mesh.p[:, fn] + u[master.node_dofs(fn.ravel())].reshape((master.dim, *fn.shape))
+        xf = self._tri_p + u[self._tri_dofs].reshape((master.dim, *fn.shape))
         nv = fn.shape[1]
         if nv == 1:
             xm = xf[:, None, :, 0]  # (d, 1, nf)
@@ -320,19 +332,37 @@ class DeformableContactPair(ContactPair):
         gap = -np.sum(n * (xs - xm), axis=0)
         m, d = s.n_points, s.dim
         nv = shape.shape[1]
-        # slave part: −n·v_s
-        r_s = np.repeat(np.arange(m), d)
-        c_s = s.node_dofs(s.nodes).T.ravel()
-        v_s = (-n).T.ravel()
-        # master part: +N_j n·v_j
-        fn = self._tris[k]  # (m, nv)
-        c_m = self.master.node_dofs(fn.ravel()).T.reshape(m, nv, d)  # (m, nv, d)
+        # slave part: −n·v_s; master part: +N_j n·v_j
+        v_s = (-n).T  # (m, d)
+        c_m = self._tri_dofs_by_point[k]  # (m, nv, d)
         v_m = shape[:, :, None] * n.T[:, None, :]
-        r_m = np.repeat(np.arange(m), nv * d)
-        vals = np.concatenate([v_s, v_m.ravel()])
-        ij = (np.concatenate([r_s, r_m]), np.concatenate([c_s, c_m.ravel()]))
-        rows = sp.csr_matrix((vals, ij), shape=(m, self.n_dofs))
+        ij = (np.concatenate([self._r_s, self._r_m]), np.concatenate([self._c_s, c_m.ravel()]))
+        rows = _rows_by_point(np.hstack([v_s, v_m.reshape(m, nv * d)]),
+                              np.hstack([self._c_s.reshape(m, d), c_m.reshape(m, nv * d)]),
+                              self.n_dofs)  # fmt: skip
+        if rows is None:  # a dof twice in a row (a surface against itself): summed by COO
+            vals = np.concatenate([v_s.ravel(), v_m.ravel()])
+            rows = sp.csr_matrix((vals, ij), shape=(m, self.n_dofs))
         return ContactGeometry(rows, gap, n, _JumpRows(ij, (m, self.n_dofs), shape))
+
+
+def _rows_by_point(vals: np.ndarray, cols: np.ndarray, n: int) -> sp.csr_matrix | None:
+    """CSR rows with the entries ``vals`` (m, w) in the columns ``cols`` (m, w), row by row.
+
+    The arrays of ``sp.csr_matrix((vals, (rows, cols)))`` (columns sorted in each row, explicit
+    zeros kept) without its COO conversion and duplicate summation (the deformable pair's
+    geometry took 150 µs a step with them, 110 without, at 26 points); None if a row has a
+    column twice (the caller sums them by COO).
+    """
+    order = np.argsort(cols, axis=1)
+    cols = np.take_along_axis(cols, order, axis=1)
+    if cols.shape[1] > 1 and np.any(cols[:, 1:] == cols[:, :-1]):
+        return None
+    m, w = cols.shape
+    index_dtype = np.int32 if max(n, m * w) < np.iinfo(np.int32).max else np.int64
+    indptr = np.arange(0, m * w + 1, w, dtype=index_dtype)
+    data = np.take_along_axis(vals, order, axis=1).ravel()
+    return sp.csr_matrix((data, cols.ravel().astype(index_dtype), indptr), shape=(m, n))
 
 
 @dataclass(frozen=True)

@@ -49,7 +49,7 @@ from .controllers import FixedStep, StepController
 from .damping import RayleighDamping
 from .impulses import ImpulseSolver
 from .registry import register
-from .rows import transposed, unilateral_block_power
+from .rows import transposed, unilateral_block_powers
 from .stability import DEFAULT_SAFETY, StableStep, check_time_step, stable_time_step
 
 __all__ = ["DEFAULT_SAFETY", "CentralDifference"]
@@ -258,12 +258,13 @@ class CentralDifference(Integrator):
             if f_app is not None:
                 v_star = v_free + dt_bar * minv * f_app
                 r_e = self._rhs_equality(v_star, u, t_next) if rows.m else r_e0
-            w_a = np.where(disp, (rhs_a - g_a @ u) / dt, rhs_a)
+            # velocity-level rows (contact) target rhs_a itself: no product with u for them
+            w_a = np.where(disp, (rhs_a - g_a @ u) / dt, rhs_a) if disp.any() else rhs_a
             r_a = g_a @ v_star - w_a
             lam_e, lam_a = solver.solve(r_e, g_a, r_a)
             v_new = v_star.copy()
             if rows.m:
-                v_new[rows.cols] -= minv[rows.cols] * (rows.matrix_cols_t @ lam_e)
+                v_new[rows.cols] -= self._minv_cols * (rows.matrix_cols_t @ lam_e)
             if g_a.shape[0]:
                 v_new -= minv * (transposed(g_a) @ lam_a)
             fulls = self._full_multipliers(lam_a / dt_bar, idx)
@@ -321,7 +322,12 @@ class CentralDifference(Integrator):
         # balance of the scheme's energy exactly for linear systems. Pending until the next
         # step starts, since a new step size at t changes the forces at t.
         half = 0.5 * dt_prev
-        self._w_pending = tuple(half * (p + q) for p, q in zip(self._p_prev, self._powers(v_minus)))
+        # the powers of these forces with v^{n+1/2} too, which the next step needs (_step_impl):
+        # the constraint forces computed once for both, kept with v^{n+1/2} itself (never
+        # modified in place; a restored run recomputes them, to the same numbers)
+        p_now, p_next = self._powers(v_minus, v_next)
+        self._p_next = (v_next, p_next)
+        self._w_pending = tuple(half * (p + q) for p, q in zip(self._p_prev, p_now))
 
     def _kick(self, v_minus: np.ndarray, dt_bar: float) -> np.ndarray:
         """The free prediction v* = v^{n−½} + Δt̄_n a^n (a new array)."""
@@ -333,23 +339,32 @@ class CentralDifference(Integrator):
         back = self._v_next - (self.dt / self._dt_bar) * (self._v_next - self._v_minus)
         return 0.5 * self.ops.block_dots(back, self.ops.mass * self._v_next)
 
-    def _powers(self, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    def _powers(self, v: np.ndarray, v2: np.ndarray | None = None):
         """External, coupling, other-constraint and damping powers per block (W) of the forces
-        at the current time with the velocity v (m/s)."""
+        at the current time with the velocity v (m/s): a tuple of four (n_blocks,) arrays; with
+        a second velocity v2, the pair of those tuples (the constraint forces computed once)."""
+        vs = (v,) if v2 is None else (v, v2)
         nb = len(self.ops.blocks)
-        p_ext = self.ops.block_dots(self._f_ext, v) if self._f_ext is not None else np.zeros(nb)
         if self.rows.m:
-            lam = self._lam_e / self._dt_bar
-            pc, po = self.rows.block_powers(lam, v[self.rows.cols])
+            cols = self.rows.cols
+            eq = self.rows.block_powers_of(self._lam_e / self._dt_bar, [x[cols] for x in vs])
         else:
-            pc, po = np.zeros(nb), np.zeros(nb)
-        if self._g_a.shape[0]:
-            po = po + unilateral_block_power(self.ops, self._g_a, self._lam_a / self._dt_bar, v)
-        if self._f_applied is not None:  # slip friction
-            po = po + self.ops.block_dots(self._f_applied, v)
-        if self._f_damp is None:
-            return p_ext, pc, po, np.zeros(nb)
-        return p_ext, pc, po, -self.ops.block_dots(self._f_damp, v)
+            eq = [(np.zeros(nb), np.zeros(nb)) for _ in vs]
+        uni = unilateral_block_powers(self.ops, self._g_a, self._lam_a / self._dt_bar, vs) \
+            if self._g_a.shape[0] else None  # fmt: skip
+        out = []
+        for i, x in enumerate(vs):
+            pc, po = eq[i]
+            if uni is not None:
+                po = po + uni[i]
+            p_ext = self.ops.block_dots(self._f_ext, x) if self._f_ext is not None else \
+                np.zeros(nb)  # fmt: skip
+            if self._f_applied is not None:  # slip friction
+                po = po + self.ops.block_dots(self._f_applied, x)
+            p_damp = np.zeros(nb) if self._f_damp is None else \
+                -self.ops.block_dots(self._f_damp, x)  # fmt: skip
+            out.append((p_ext, pc, po, p_damp))
+        return out[0] if v2 is None else (out[0], out[1])
 
     def _damping_force(self, v: np.ndarray) -> np.ndarray | None:
         """C v (N) with the mid-step velocity v that precedes the force's time, or None."""
@@ -422,7 +437,10 @@ class CentralDifference(Integrator):
         # the step size at t is final now: commit the works of the step that ended at t
         self._w_ext, self._w_coupling, self._w_constraint = self._works()
         self._w_damping = self._damping_work()
-        self._p_prev = self._powers(v_half)  # the forces at t with this step's velocity
+        # the forces at t with this step's velocity (computed with the impulse at t)
+        cached = getattr(self, "_p_next", None)
+        self._p_prev = cached[1] if cached is not None and cached[0] is v_half else \
+            self._powers(v_half)  # fmt: skip
         # commit the step's kinematics and model states
         if not self.ops.linear:
             self._w_internal += self.ops.block_dots(u_new - self.u, 0.5 * (self._f_int + f_int))

@@ -8,12 +8,11 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-import scipy.linalg as sla
 import scipy.sparse as sp
 
 from ..contract import ConstraintError
-from .linalg import factor_checked, factor_rows
-from .rows import rows_key
+from .linalg import dense_cho_factor, dense_cho_solve, factor_checked, factor_rows
+from .rows import rows_key, transposed
 
 __all__ = ["ImpulseSolver"]
 
@@ -85,8 +84,8 @@ class ImpulseSolver:
         key = self._key(g_a)
         minv = self.inv_mass
         # G_A M⁻¹ by scaling its entries (no diagonal matrix, no product): reused below
-        ga_m = g_a.copy()
-        ga_m.data = ga_m.data * minv[ga_m.indices]
+        ga_m = sp.csr_matrix((g_a.data * minv[g_a.indices], g_a.indices.copy(),
+                              g_a.indptr.copy()), shape=g_a.shape)  # fmt: skip
         if self.m_e and not self._eq_mask[g_a.indices].any():
             # no dof shared with the equality rows (a wall and a symmetry axis): two blocks
             def build_aa_only():
@@ -105,17 +104,18 @@ class ImpulseSolver:
         if m_a <= self._DENSE_SCHUR:
 
             def build_schur():
-                s_aa = (ga_m @ g_a.T).tocsr()
+                # G_Aᵀ from the shared cache: the integrator applies it to Λ_A right after
+                s_aa = (ga_m @ transposed(g_a)).tocsr()
                 # only the active rows that share a dof with the equality rows have a non-zero
                 # column in (B M⁻¹ G_Aᵀ): solve for those alone (a few near a symmetry axis)
                 coupled = np.nonzero(np.diff(s_ae.indptr))[0]
-                x = self.lu.solve(s_ae[coupled].T.toarray()) if coupled.size else \
-                    np.zeros((self.m_e, 0))  # fmt: skip
+                x = self.lu.solve(_dense_rows_t(s_ae, coupled, self.m_e)) if coupled.size \
+                    else np.zeros((self.m_e, 0))  # fmt: skip
                 schur = s_aa.toarray()
                 if coupled.size:
                     schur[:, coupled] -= s_ae @ x
                 try:
-                    cho = sla.cho_factor(schur)
+                    cho = dense_cho_factor(schur)
                 except np.linalg.LinAlgError as exc:
                     raise ConstraintError(
                         "active unilateral rows are dependent on each other or on the equality "
@@ -125,7 +125,7 @@ class ImpulseSolver:
 
             coupled, x, cho = self._cached(key, build_schur)
             y = self.lu.solve(r_e)
-            lam_a = sla.cho_solve(cho, r_a - s_ae @ y)
+            lam_a = dense_cho_solve(cho, r_a - s_ae @ y)
             if coupled.size:
                 y = y - x @ lam_a[coupled]
             return y, lam_a
@@ -139,3 +139,15 @@ class ImpulseSolver:
         return sol[: self.m_e], sol[self.m_e :]
 
 
+
+
+def _dense_rows_t(mat: sp.csr_matrix, rows: np.ndarray, n: int) -> np.ndarray:
+    """``mat[rows].T.toarray()`` (n, len(rows)) of a CSR matrix without duplicate entries,
+    scattered from its arrays (scipy's row indexing and transpose cost more than the solve
+    they feed, every step of a deformable contact)."""
+    start = mat.indptr[rows]
+    cnt = mat.indptr[rows + 1] - start
+    pos = np.repeat(start - (np.cumsum(cnt) - cnt), cnt) + np.arange(int(cnt.sum()))
+    out = np.zeros((n, rows.size), order="F")  # the layout of toarray's: the same products
+    out[mat.indices[pos], np.repeat(np.arange(rows.size), cnt)] = mat.data[pos]
+    return out
