@@ -79,7 +79,7 @@ def solid_j2_kernel(
     dv0, alpha (ne, nq); fbar (bool); K, G (Pa); code, prm (6,) the hardening law; dt (s, ≤ 0:
     rates off); the committed state cp_inv (3, 3, ne, nq), eqps, wp, wv, jac_old (ne, nq);
     visc (4,) and h0 (ne,) as :func:`arlequin.models.j2_kernel.planar_j2_kernel`. Scratch, one
-    slot per thread: scratch_h (n_threads, nq, 10) H and J − 1, scratch_g (n_threads, nq + 1,
+    slot per thread: scratch_h (n_threads, nq, 19) H, J − 1 and F⁻¹, scratch_g (n_threads, nq + 1,
     nen, 3) ∇ₓN_a per point and the cell's mean divergences, scratch_m (n_threads, 4, 3, 3).
     Outputs (overwritten): fe (3, nen, ne), cp_new, tau_out (3, 3, ne, nq), eqps_new, j_out,
     wp_new, wv_new (ne, nq), flags (ne,): 1 inverted cell, 2 return map not converged.
@@ -93,7 +93,7 @@ def solid_j2_kernel(
         tid = nb.get_thread_id()
         hs = scratch_h[tid]
         gs = scratch_g[tid]
-        m = scratch_m[tid]  # m[0] E = b_e − 1, m[1] its axes, m[2] F⁻¹, m[3] T
+        m = scratch_m[tid]  # m[0] E = b_e − 1, m[1] its axes, m[2] F⁻¹ v_k, m[3] T
         vol0 = 0.0
         volj_m1 = 0.0
         volj_old = 0.0
@@ -160,6 +160,9 @@ def solid_j2_kernel(
             i20 = (f10 * f21 - f11 * f20) * idet
             i21 = (f01 * f20 - f00 * f21) * idet
             i22 = (f00 * f11 - f01 * f10) * idet
+            hs[q, 10], hs[q, 11], hs[q, 12] = i00, i01, i02  # F⁻¹, for C_p⁻¹ below
+            hs[q, 13], hs[q, 14], hs[q, 15] = i10, i11, i12
+            hs[q, 16], hs[q, 17], hs[q, 18] = i20, i21, i22
             jw = jq * dv0[e, q]
             for a in range(nen):
                 g0 = grad[e, q, a, 0]
@@ -247,24 +250,13 @@ def solid_j2_kernel(
                 x1 = math.exp(2.0 * (lj + shrink * d1))
                 x2 = math.exp(2.0 * (lj + shrink * d2))
                 x3 = math.exp(2.0 * (lj + shrink * d3))
-                # F⁻¹ v_k, the columns of m[2]
-                f00, f01, f02 = 1.0 + hs[q, 0], hs[q, 1], hs[q, 2]
-                f10, f11, f12 = hs[q, 3], 1.0 + hs[q, 4], hs[q, 5]
-                f20, f21, f22 = hs[q, 6], hs[q, 7], 1.0 + hs[q, 8]
-                idet = 1.0 / jq
-                i00 = (f11 * f22 - f12 * f21) * idet
-                i01 = (f02 * f21 - f01 * f22) * idet
-                i02 = (f01 * f12 - f02 * f11) * idet
-                i10 = (f12 * f20 - f10 * f22) * idet
-                i11 = (f00 * f22 - f02 * f20) * idet
-                i12 = (f02 * f10 - f00 * f12) * idet
-                i20 = (f10 * f21 - f11 * f20) * idet
-                i21 = (f01 * f20 - f00 * f21) * idet
-                i22 = (f00 * f11 - f01 * f10) * idet
-                for k in range(3):
-                    m[2, 0, k] = i00 * v[0, k] + i01 * v[1, k] + i02 * v[2, k]
-                    m[2, 1, k] = i10 * v[0, k] + i11 * v[1, k] + i12 * v[2, k]
-                    m[2, 2, k] = i20 * v[0, k] + i21 * v[1, k] + i22 * v[2, k]
+                # F⁻¹ v_k, the columns of m[2] (F⁻¹ kept from the gradients' pass)
+                for i in range(3):
+                    r0 = hs[q, 10 + 3 * i]
+                    r1 = hs[q, 11 + 3 * i]
+                    r2 = hs[q, 12 + 3 * i]
+                    for k in range(3):
+                        m[2, i, k] = r0 * v[0, k] + r1 * v[1, k] + r2 * v[2, k]
                 w = m[2]
                 for i in range(3):
                     for j in range(i, 3):
@@ -307,7 +299,7 @@ def solid_j2_kernel(
 def solid_scratch(n_qp: int = 8, nen: int = 8) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Per-thread scratch buffers of :func:`solid_j2_kernel`."""
     n = nb.config.NUMBA_NUM_THREADS
-    return np.empty((n, n_qp, 10)), np.empty((n, n_qp + 1, nen, 3)), np.empty((n, 4, 3, 3))
+    return np.empty((n, n_qp, 19)), np.empty((n, n_qp + 1, nen, 3)), np.empty((n, 4, 3, 3))
 
 
 def warm_up_solid() -> None:

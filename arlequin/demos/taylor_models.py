@@ -50,7 +50,7 @@ from ..problem import ArlequinProblem, Patch
 from ..system import Block, BlockTerm, CoupledSystem, LinearConstraint
 from .taylor_meshes import ArlequinBarSizes, taylor_bar_mesh
 
-__all__ = ["LAW_DEFAULTS", "ArlequinBar", "MonoBar", "hardening_parameters"]
+__all__ = ["LAW_DEFAULTS", "ArlequinBar", "ArlequinBarView", "MonoBar", "hardening_parameters"]
 
 #: Part of the lateral surface, from the impact face, that the wall may meet (it folds onto the
 #: wall as the mushroom forms), as a fraction of the bar length.
@@ -206,7 +206,50 @@ class MonoBar:
         render_taylor_bar(self.model, u, state, path, title)
 
 
-class ArlequinBar:
+class ArlequinBarView:
+    """What the Arlequin bars (axisymmetric and 3D) show the recorder alike: the split of a
+    system vector, the weighted energies, the field frames and the band's plastic strain.
+
+    Needs ``self._c``, ``self._f`` (the blocks' slices), ``coupling``, ``model``, ``layout``,
+    ``system``, ``coarse_mesh``, ``fine_mesh``, ``band_cells`` and ``fine_state``.
+    """
+
+    def split(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The coarse and the patch parts of a system vector ``u``."""
+        return u[self._c], u[self._f]
+
+    def energies(self, integ, e: dict) -> dict[str, float]:
+        """Weighted energies of both models and the net work of the coupling forces (J);
+        ``e`` is ``integ.energies()``."""
+        state = self.fine_state(integ)
+        uf = integ.u[self._f]
+        alpha = self.coupling.alpha_fine
+        return {
+            "elastic": e["strain"]["coarse"] + self.model.stored_energy(uf, state, alpha),
+            "plastic_dissipation": self.model.plastic_dissipation(state, alpha),
+            "viscous_dissipation": self.model.viscous_dissipation(state, alpha),
+            "coupling_work": float(sum(e["coupling_work"].values())),
+        }
+
+    def series_meshes(self) -> dict[str, Any]:
+        """Series name -> reference mesh of the field series the run writes."""
+        return {"coarse": self.coarse_mesh, "patch": self.fine_mesh}
+
+    def frame(self, integ) -> dict[str, tuple[dict, dict]]:
+        """Series name -> (point data, cell data) of one field frame at the integrator's time."""
+        frames = self.layout.frame(self.system.dofmap, integ.u, integ.v, integ.multipliers)
+        state = self.fine_state(integ)
+        frames["patch"][1]["plastic_strain"] = state.eqps.mean(axis=1)
+        frames["patch"][1]["von_mises"] = state.von_mises.mean(axis=1)
+        return frames
+
+    def band_plastic_strain(self, state) -> float:
+        """Largest ε̄p at the quadrature points of the gluing band's fine cells."""
+        return float(np.asarray(state.eqps)[self.band_cells].max())
+
+
+
+class ArlequinBar(ArlequinBarView):
     """The coarse linear-elastic bar plus the refined finite-strain J2 patch (module docstring).
 
     Blocks ``"coarse"`` and ``"patch"``; u_r = 0 on the axis of both; the wall on the patch's
@@ -293,10 +336,6 @@ class ArlequinBar:
         """The finite-strain model's quadrature state (``PlasticState``) in the integrator."""
         return integ.states["patch"][0]
 
-    def split(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The coarse and the patch parts of a system vector ``u``."""
-        return u[self._c], u[self._f]
-
     def measures(self, u: np.ndarray) -> tuple[float, float]:
         """(length from the coarse model's top node on the axis, footprint radius from the
         patch's impact face) (m)."""
@@ -304,35 +343,6 @@ class ArlequinBar:
         length = self.coarse_mesh.p[1, self._axis_top] + uc[2 * self._axis_top + 1]
         r = self.fine_mesh.p[0, self._face] + uf[2 * self._face]
         return float(length), float(r.max())
-
-    def energies(self, integ, e: dict) -> dict[str, float]:
-        """Weighted energies of both models and the net work of the coupling forces (J);
-        ``e`` is ``integ.energies()``."""
-        state = self.fine_state(integ)
-        uf = integ.u[self._f]
-        alpha = self.coupling.alpha_fine
-        return {
-            "elastic": e["strain"]["coarse"] + self.model.stored_energy(uf, state, alpha),
-            "plastic_dissipation": self.model.plastic_dissipation(state, alpha),
-            "viscous_dissipation": self.model.viscous_dissipation(state, alpha),
-            "coupling_work": float(sum(e["coupling_work"].values())),
-        }
-
-    def series_meshes(self) -> dict[str, Any]:
-        """Series name -> reference mesh of the field series the run writes."""
-        return {"coarse": self.coarse_mesh, "patch": self.fine_mesh}
-
-    def frame(self, integ) -> dict[str, tuple[dict, dict]]:
-        """Series name -> (point data, cell data) of one field frame at the integrator's time."""
-        frames = self.layout.frame(self.system.dofmap, integ.u, integ.v, integ.multipliers)
-        state = self.fine_state(integ)
-        frames["patch"][1]["plastic_strain"] = state.eqps.mean(axis=1)
-        frames["patch"][1]["von_mises"] = state.von_mises.mean(axis=1)
-        return frames
-
-    def band_plastic_strain(self, state) -> float:
-        """Largest ε̄p at the quadrature points of the gluing band's fine cells."""
-        return float(np.asarray(state.eqps)[self.band_cells].max())
 
     def render(self, u, state, path: str, title: str) -> None:
         """The picture of the final state (PNG at ``path``), pyvista off-screen."""

@@ -38,7 +38,7 @@ from ..problem import ArlequinProblem
 from ..system import Block, BlockTerm, CoupledSystem, LinearConstraint
 from .taylor_meshes import ArlequinBarSizes
 from .taylor_meshes_3d import patch_levels, quarter_bar_mesh, refined_bar_mesh
-from .taylor_models import LATERAL_CONTACT
+from .taylor_models import LATERAL_CONTACT, ArlequinBarView
 
 __all__ = ["ArlequinBar3D", "MonoBar3D"]
 
@@ -191,7 +191,7 @@ class MonoBar3D(_Quarter):
         return {"bar": (point, cell)}
 
 
-class ArlequinBar3D(_Quarter):
+class ArlequinBar3D(ArlequinBarView, _Quarter):
     """The coarse linear-elastic quarter bar plus the nested finite-strain J2 patch.
 
     Blocks ``"coarse"`` and ``"patch"``; symmetry conditions on both (and dropped from the
@@ -277,41 +277,9 @@ class ArlequinBar3D(_Quarter):
         #: p: the patch's share of the fine elements of a uniform mesh at its resolution
         self.patch_fraction = cells.size / cmesh.nelements
 
-    def split(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The coarse and the patch parts of a system vector ``u``."""
-        return u[self._c], u[self._f]
-
     def measures(self, u: np.ndarray) -> tuple[float, float]:
         """(length from the coarse model's top node on the axis, footprint radius from the
         patch's impact face) (m)."""
         uc, uf = self.split(u)
         return float(self.coarse_mesh.p[2, self._axis_top] + uc[3 * self._axis_top + 2]), \
             self._footprint(uf)  # fmt: skip
-
-    def energies(self, integ, e: dict) -> dict[str, float]:
-        """Weighted energies of both models and the net work of the coupling forces (J)."""
-        state = self.fine_state(integ)
-        uf = integ.u[self._f]
-        alpha = self.coupling.alpha_fine
-        return {
-            "elastic": e["strain"]["coarse"] + self.model.stored_energy(uf, state, alpha),
-            "plastic_dissipation": self.model.plastic_dissipation(state, alpha),
-            "viscous_dissipation": self.model.viscous_dissipation(state, alpha),
-            "coupling_work": float(sum(e["coupling_work"].values())),
-        }
-
-    def series_meshes(self) -> dict[str, Any]:
-        """Series name -> reference mesh of the field series the run writes."""
-        return {"coarse": self.coarse_mesh, "patch": self.fine_mesh}
-
-    def frame(self, integ) -> dict[str, tuple[dict, dict]]:
-        """Series name -> (point data, cell data) of one field frame at the integrator's time."""
-        frames = self.layout.frame(self.system.dofmap, integ.u, integ.v, integ.multipliers)
-        state = self.fine_state(integ)
-        frames["patch"][1]["plastic_strain"] = state.eqps.mean(axis=1)
-        frames["patch"][1]["von_mises"] = state.von_mises.mean(axis=1)
-        return frames
-
-    def band_plastic_strain(self, state) -> float:
-        """Largest ε̄p at the quadrature points of the gluing band's fine cells."""
-        return float(np.asarray(state.eqps)[self.band_cells].max())
