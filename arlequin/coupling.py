@@ -72,8 +72,13 @@ def gram_matrix(
     length: float = 0.0,
     axisymmetric: bool = False,
     intorder: int = 3,
+    closed_form: bool = True,
 ) -> sp.csr_matrix:
     """Gram matrix of c(·,·) on the gluing cells of the integration mesh.
+
+    Triangles and tetrahedra (not axisymmetric) take the closed form of P1 functions
+    (``closed_form``, the default); other cells, or ``closed_form=False``, scikit-fem's
+    quadrature of order ``intorder``.
 
     Returns
     -------
@@ -87,9 +92,11 @@ def gram_matrix(
     gluing_cells = np.asarray(gluing_cells, dtype=np.int64)
     if gluing_cells.size == 0:
         raise MediatorError("the gluing zone is empty: no integration cell lies in it")
+    ell2 = float(length) ** 2 if coupling == "H1" else 0.0
+    if closed_form and _is_simplex(mesh) and not axisymmetric and mesh.dim() == n_components:
+        return _simplex_gram(mesh, gluing_cells, ell2)
     element = ElementVector(scalar_element_for(mesh), dim=n_components)
     basis = Basis(mesh, element, elements=gluing_cells, intorder=intorder)
-    ell2 = float(length) ** 2 if coupling == "H1" else 0.0
 
     def strain(u):
         g = grad(u)
@@ -104,6 +111,50 @@ def gram_matrix(
         return value * measure
 
     return form.assemble(basis).tocsr()
+
+
+def _is_simplex(mesh) -> bool:
+    return mesh.t.shape[0] == mesh.dim() + 1 and mesh.dim() >= 2
+
+
+def _simplex_gram(mesh, cells: np.ndarray, ell2: float) -> sp.csr_matrix:
+    """The L2/H1 Gram matrix of vector P1 functions on simplices, in closed form.
+
+    On a simplex T of measure |T| with barycentric gradients g_a (constant),
+    ∫_T φ_a φ_b = |T| (1 + δ_ab) / ((d + 1)(d + 2)) and
+    ε(φ_a e_i) : ε(φ_b e_j) = ½ (δ_ij g_a·g_b + g_a,j g_b,i): the same matrix as the quadrature
+    of :func:`gram_matrix`'s form (tested to round-off), without the (12 × 12 functions ×
+    quadrature points) arrays of a vector basis, in chunks of cells (bounded memory).
+    """
+    d = mesh.dim()
+    nv = d + 1
+    n = d * mesh.nvertices
+    out = sp.csr_matrix((n, n))
+    mass_ref = (np.ones((nv, nv)) + np.eye(nv)) / ((d + 1) * (d + 2))
+    eye = np.eye(d)
+    for start in range(0, cells.size, _GRAM_CHUNK):
+        c = cells[start : start + _GRAM_CHUNK]
+        x = np.transpose(mesh.p[:, mesh.t[:, c]], (2, 1, 0))  # (m, nv, d)
+        jac = np.transpose(x[:, 1:] - x[:, :1], (0, 2, 1))  # columns x_k − x_0
+        vol = np.abs(np.linalg.det(jac)) / {2: 2.0, 3: 6.0}[d]
+        inv = np.linalg.inv(jac)  # rows: gradients of λ_1..λ_d
+        g = np.concatenate([-inv.sum(axis=1, keepdims=True), inv], axis=1)  # (m, nv, d)
+        # local (a, i, b, j)
+        local = np.einsum("m,ab,ij->maibj", vol, mass_ref, eye)
+        if ell2:
+            gg = np.einsum("mak,mbk->mab", g, g)
+            local += 0.5 * ell2 * vol[:, None, None, None, None] * (
+                np.einsum("mab,ij->maibj", gg, eye) + np.einsum("maj,mbi->maibj", g, g)
+            )
+        dofs = d * mesh.t[:, c].T[:, :, None] + np.arange(d)  # (m, nv, d): d·node + i
+        rows = np.broadcast_to(dofs[:, :, :, None, None], local.shape)
+        cols = np.broadcast_to(dofs[:, None, None, :, :], local.shape)
+        out = out + sp.csr_matrix((local.ravel(), (rows.ravel(), cols.ravel())), shape=(n, n))
+    return out
+
+
+#: Cells of one chunk of the closed-form Gram matrix (about 150 MB of temporaries in 3D).
+_GRAM_CHUNK = 100_000
 
 
 def coupling_matrices(

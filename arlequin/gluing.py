@@ -18,23 +18,18 @@ from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
-from skfem import Basis
 
 from .coupling import CouplingMatrices, MediatorError, coupling_matrices
+from .exactness import ExactnessWarning, exactness_failures
 from .geometry import distance_to_facets, facet_coordinates, outward_normals
 from .locate import cell_centroids, cell_sizes, locate_points
-from .overlap import Overlap, build_overlap
+from .overlap import Overlap, build_overlap, check_meshes
 from .patches import Patch
-from .reference import scalar_element_for
 from .system import BlockTerm
 from .weights import PartitionWeights, check_partition_of_unity
 
 __all__ = ["ExactnessWarning", "PatchCoupling"]  # Patch: arlequin.patches (imported here too)
 
-
-class ExactnessWarning(UserWarning):
-    """The patch breaks a documented exactness condition: a uniform stress state is not
-    reproduced exactly (the message names the condition and a setting that meets it)."""
 
 logger = logging.getLogger(__name__)
 
@@ -52,9 +47,7 @@ class PatchCoupling:
         self.fine_model = patch.model
         self.weights: PartitionWeights = patch.weights  # type: ignore[assignment]
         cmesh, fmesh = coarse_model.mesh, patch.model.mesh
-        self.overlap: Overlap = build_overlap(
-            cmesh, fmesh, patch.overlap_method, patch.boundary_tol
-        )
+        check_meshes(cmesh, fmesh)  # before the boundary classification uses both meshes
         self.n_components = int(coarse_model.n_components)
         if int(patch.model.n_components) != self.n_components:
             raise ValueError(
@@ -68,7 +61,21 @@ class PatchCoupling:
             )
         self.axisymmetric = coarse_model.kind == "axisymmetric"
         self._classify_boundary()
-        self._gluing_zone()
+        self._fine_gluing_zone()
+        self._surely_covered: np.ndarray | None = None
+        trim = self.weights.mode in ("nodal", "cell")
+        self.overlap: Overlap = build_overlap(
+            cmesh, fmesh, patch.overlap_method, patch.boundary_tol,
+            pair_filter=self._pieces_needed if trim else None,
+        )  # fmt: skip
+        #: α_coarse beyond the band (ε), carried by the coarse cells themselves where the
+        #: overlap is trimmed (0 otherwise: the integration cells carry all of α_coarse)
+        self.coarse_floor = self._floor() if self.overlap.trimmed else 0.0
+        self.gluing_cells = np.nonzero(self._fine_gluing_mask[self.overlap.fine_cells])[0]
+        if self.gluing_cells.size == 0:
+            raise MediatorError(
+                f"empty gluing zone for {self.name}: it does not overlap the coarse mesh"
+            )
         self.integration_model = coarse_model.with_mesh(self.overlap.integration_mesh)
         self._evaluate_weights()
         length = patch.length if patch.length is not None else self.default_h1_length()
@@ -81,82 +88,9 @@ class PatchCoupling:
             patch.mediator,
             self.axisymmetric,
         )
-        self.exactness_failures = self._diagnose_exactness()
+        self.exactness_failures = exactness_failures(self)
         for failure in self.exactness_failures:
             warnings.warn(f"{self.name}: {failure}", ExactnessWarning, stacklevel=3)
-
-    # ------------------------------------------------------------------ exactness
-    def _diagnose_exactness(self) -> list[str]:
-        """The exactness conditions of docs/theory.md this patch breaks ([] if none).
-
-        Condition A: a nested patch with the fine mediator (whose space contains the coarse one
-        on S_g), weights constant outside S_g. Condition B: ramp weights whose gradient ∇α_c is
-        one constant vector over the part of S_g each mediator function sees (straight bands,
-        no function meeting two bands), so that σ·∇α_c lies in the mediator space. User weights
-        are not checked (logged).
-        """
-        nested = self.overlap.method == "nested"
-        same_space = nested and self.fine_model.mesh.nelements == np.unique(
-            self.overlap.coarse_cells
-        ).size  # the patch is the coarse mesh itself: both mediators are the fine space
-        fine_mediator = self.patch.mediator == "fine" or same_space
-        if nested and fine_mediator:
-            return []  # condition A
-        name = type(self.weights).__name__
-        if name == "ConstantWeights":
-            return [
-                "constant weights reproduce a uniform stress exactly only on a nested patch "
-                "with the fine mediator (condition A of docs/theory.md; measured errors 1e-3 to "
-                "4e-2 otherwise): use weights='ramp' with straight bands, or mediator='fine' "
-                "on a nested patch"
-            ]
-        if name != "RampWeights":
-            logger.info("%s: exactness of user weights %s not checked", self.name, name)
-            return []
-        return self._diagnose_ramp()
-
-    def _diagnose_ramp(self) -> list[str]:
-        """Condition B for ramp weights: one weight gradient per mediator function."""
-        imesh = self.overlap.integration_mesh
-        cells = self.gluing_cells
-        basis = Basis(imesh, scalar_element_for(imesh), elements=cells, intorder=2)
-        nodal = self.weights.alpha_coarse(imesh.p, self._node_distance(imesh), self.gluing_width)
-        grad = np.asarray(basis.interpolate(np.asarray(nodal, dtype=float)).grad)  # (d, nc, nq)
-        scale = float(np.max(np.abs(grad))) if grad.size else 0.0
-        if scale == 0.0:
-            return []
-        coarse = self.patch.mediator == "coarse"
-        owner = self.overlap.coarse_cells[cells] if coarse else self.overlap.fine_cells[cells]
-        mesh = self.coarse_model.mesh if coarse else self.fine_model.mesh
-        nodes = mesh.t[:, owner]  # (n_v, n_gc): the mediator functions over each gluing cell
-        n_v, n_gc = nodes.shape
-        node_of = nodes.ravel()
-        cell_of = np.tile(np.arange(n_gc), n_v)
-        lo = np.full((grad.shape[0], mesh.nvertices), np.inf)
-        hi = np.full((grad.shape[0], mesh.nvertices), -np.inf)
-        g_min, g_max = grad.min(axis=2), grad.max(axis=2)  # (d, n_gc)
-        for i in range(grad.shape[0]):
-            np.minimum.at(lo[i], node_of, g_min[i, cell_of])
-            np.maximum.at(hi[i], node_of, g_max[i, cell_of])
-        spread = np.max(np.where(np.isfinite(lo), hi - lo, 0.0), axis=0)
-        bad = np.nonzero(spread > 1e-6 * scale)[0]
-        if bad.size == 0:
-            return []
-        worst = int(bad[np.argmax(spread[bad])])
-        x = ", ".join(f"{c:.4g}" for c in mesh.p[:, worst])
-        which = "coarse" if coarse else "fine"
-        return [
-            f"{bad.size} {which} mediator function(s) see different gradients of the ramp "
-            f"weight on the gluing zone (the worst at x = ({x}) m: the band turns a corner, is "
-            "curved, or one function meets two bands), so σ·∇α_c is not in the mediator space "
-            "(condition B of docs/theory.md) and a uniform stress is not reproduced exactly"
-            + (" (with the coarse mediator on a non-nested 3D patch whose band turns edges, the "
-               "error reached the size of the solution itself)" if coarse and
-               self.overlap.method != "nested" and mesh.dim() == 3 else "")
-            + ": use mediator='fine' (exact on a nested patch, condition A; on a non-nested one "
-            "far closer), or straight bands whose "
-            f"{which} mediator functions each meet a single band"
-        ]
 
     def default_h1_length(self) -> float:
         """Default H1 coupling length ℓ (m): the mean coarse cell size on the gluing zone.
@@ -264,10 +198,11 @@ class PatchCoupling:
             inside[np.nonzero(undecided)[0][exact < width]] = True
         return inside
 
-    def _gluing_zone(self) -> None:
+    def _fine_gluing_zone(self) -> None:
         fmesh = self.fine_model.mesh
         centroids = cell_centroids(fmesh)
         self._distance_cache: dict = {}
+        self._fine_values: dict = {}
         # distances only matter up to the band width (weights saturate beyond it): exact up to
         # the width plus one fine cell, lower bounds beyond
         self._distance_cap = (
@@ -302,28 +237,101 @@ class PatchCoupling:
                 f"(gluing_width={self.patch.gluing_width})"
             )
         self.gluing_width = width
+        self._fine_gluing_mask = fine_gluing
         self.fine_gluing_cells = np.nonzero(fine_gluing)[0]
-        self.gluing_cells = np.nonzero(fine_gluing[self.overlap.fine_cells])[0]
-        if self.gluing_cells.size == 0:
-            raise MediatorError(
-                f"empty gluing zone for {self.name}: it does not overlap the coarse mesh"
-            )
+
+    # ------------------------------------------------------------------ trimmed overlaps
+    def _floor(self) -> float:
+        """α_coarse beyond the gluing band (m): the weights' value at twice the band width."""
+        x = np.zeros((self.fine_model.mesh.dim(), 1))
+        d = np.array([2.0 * self.gluing_width])
+        return float(np.asarray(self.weights.alpha_coarse(x, d, self.gluing_width)).ravel()[0])
+
+    def _weighted_fine_cells(self) -> np.ndarray:
+        """Patch cells on which α_coarse is not the floor somewhere, shape (n_fine_cells,) bool.
+
+        The integration cells inside them carry α_coarse − floor ≠ 0 (nodal weights: a vertex
+        value differs; cell weights: the cell's value does).
+        """
+        fmesh = self.fine_model.mesh
+        floor = self._floor()
+        if self.weights.mode == "nodal":
+            return np.any(self._fine_nodal("coarse")[fmesh.t] != floor, axis=0)
+        return self._fine_cell_values("coarse") != floor
+
+    def _pieces_needed(self, fine_cells: np.ndarray, coarse_cells: np.ndarray) -> np.ndarray:
+        """Which candidate pairs (patch cell, coarse cell) the overlap must intersect.
+
+        A coarse cell C that surely lies inside the patch gets α_coarse = floor = ε on itself
+        (its own term) and α_coarse − ε on the integration cells, which vanishes outside the
+        patch cells that see the band (:meth:`_weighted_fine_cells`): only those pieces of C
+        are cut. Every piece of the other coarse cells is cut (partly covered cells need the
+        whole overlap, −α_fine on it). C surely lies inside when its centroid c is inside the
+        patch and farther than its circumradius about c, r_C = max |v − c|, from every facet of
+        the patch's boundary (the distance is 1-Lipschitz, so no point of C reaches a facet).
+        """
+        cmesh, fmesh = self.coarse_model.mesh, self.fine_model.mesh
+        cand = np.unique(coarse_cells)
+        c = cell_centroids(cmesh)[:, cand]
+        r = np.max(np.linalg.norm(cmesh.p[:, cmesh.t[:, cand]] - c[:, None, :], axis=0), axis=0)
+        cap = float(r.max()) * (1.0 + 1e-9)
+        far = self.distance(c, cap) > r * (1.0 + 1e-9)
+        if self.outer_facets.size:
+            outer = facet_coordinates(fmesh, self.outer_facets)
+            far &= distance_to_facets(c, outer, cap=cap) > r * (1.0 + 1e-9)
+        far[far] = locate_points(fmesh, c[:, far], tol=0.0).inside
+        self._surely_covered = np.zeros(cmesh.nelements, dtype=bool)
+        self._surely_covered[cand[far]] = True
+        return self._weighted_fine_cells()[fine_cells] | ~self._surely_covered[coarse_cells]
+
 
     # ------------------------------------------------------------------ weights
-    def _weights_at(self, basis, which: str) -> np.ndarray:
-        """α_which at the quadrature points of a scalar cell basis, shape (n_elems, n_qp)."""
-        mesh = basis.mesh
-        fn = self.weights.alpha_coarse if which == "coarse" else self.weights.alpha_fine
+    def _fine_nodal(self, which: str) -> np.ndarray:
+        """α_which at the patch's nodes (nodal weights), shape (n_fine_nodes,), cached."""
+        key = ("nodal", which)
+        if key not in self._fine_values:
+            fn = self.weights.alpha_coarse if which == "coarse" else self.weights.alpha_fine
+            fmesh = self.fine_model.mesh
+            self._fine_values[key] = np.asarray(
+                fn(fmesh.p, self._node_distance(fmesh), self.gluing_width), dtype=float
+            )
+        return self._fine_values[key]
+
+    def _fine_cell_values(self, which: str) -> np.ndarray:
+        """α_which of the patch's cells (cell weights, at their centroids), cached."""
+        key = ("cell", which)
+        if key not in self._fine_values:
+            fn = self.weights.alpha_coarse if which == "coarse" else self.weights.alpha_fine
+            fmesh = self.fine_model.mesh
+            self._fine_values[key] = np.asarray(
+                fn(cell_centroids(fmesh), self._centroid_distance(fmesh), self.gluing_width),
+                dtype=float,
+            )
+        return self._fine_values[key]
+
+    def _weights_at(self, basis, which: str, overlap: bool = False) -> np.ndarray:
+        """α_which at the quadrature points of a scalar cell basis, shape (n_elems, n_qp).
+
+        On the patch mesh (``overlap=False``) nodal weights are the ramp's nodal values
+        interpolated by the patch's first-order functions, cell weights the value at each
+        cell's centroid. On the integration mesh (``overlap=True``) they are the same
+        functions of the patch carried over (the patch's nodal values through the fine
+        transfer, each patch cell's value on its pieces), so that α_coarse + α_fine = 1 holds
+        between the two models' weights exactly wherever the ramp is not linear on a patch
+        cell, and no distance is computed at the integration mesh's many nodes.
+        """
         mode = self.weights.mode
         if mode == "nodal":
-            nodal = fn(mesh.p, self._node_distance(mesh), self.gluing_width)
-            return np.asarray(basis.interpolate(np.asarray(nodal, dtype=float)))
+            nodal = self._fine_nodal(which)
+            if overlap:
+                nodal = self.overlap.fine_transfer @ nodal
+            return np.asarray(basis.interpolate(nodal))
         if mode == "cell":
-            c = cell_centroids(mesh)
-            per_cell = np.asarray(
-                fn(c, self._centroid_distance(mesh), self.gluing_width), dtype=float
-            )
+            per_cell = self._fine_cell_values(which)
+            if overlap:
+                per_cell = per_cell[self.overlap.fine_cells]
             return np.repeat(per_cell[:, None], basis.dx.shape[1], axis=1)
+        fn = self.weights.alpha_coarse if which == "coarse" else self.weights.alpha_fine
         x = np.asarray(basis.global_coordinates())
         return np.broadcast_to(
             fn(x, self.distance(x, self._distance_cap), self.gluing_width), basis.dx.shape
@@ -336,8 +344,8 @@ class PatchCoupling:
 
     def _evaluate_weights(self) -> None:
         ibasis = self.integration_model.scalar_basis()
-        alpha_c = self._weights_at(ibasis, "coarse")
-        alpha_f = self._weights_at(ibasis, "fine")
+        alpha_c = self._weights_at(ibasis, "coarse", overlap=True)
+        alpha_f = self._weights_at(ibasis, "fine", overlap=True)
         check_partition_of_unity(alpha_c, alpha_f, np.asarray(ibasis.mapping.F(ibasis.X)))
         self.alpha_fine_overlap = alpha_f
         self.alpha_coarse_overlap = alpha_c
@@ -369,16 +377,28 @@ class PatchCoupling:
         c_measure = self.coarse_model.scalar_basis().dx.sum(axis=1)
         # >=: a patch whose nodes were projected onto a convex curved boundary can cover a
         # coarse cell by more than its measure; subtracting there would give a negative weight
-        return i_measure >= (1.0 - 1e-9) * c_measure
+        covered = i_measure >= (1.0 - 1e-9) * c_measure
+        if self._surely_covered is not None and self.overlap.trimmed:
+            covered |= self._surely_covered  # inside the patch, its pieces trimmed
+        return covered
 
-    def coarse_overlap_term(self) -> BlockTerm:
-        """The coarse model's contribution inside the overlap, integrated on the overlap cells.
+    def coarse_overlap_weight(self) -> np.ndarray:
+        """Weight of the coarse model's term on the integration cells, shape (n_I, n_qp).
 
-        Weight α_coarse on the overlap cells of fully covered coarse cells, −α_fine on those of
-        partly covered ones (see :attr:`covered_coarse_cells`).
+        α_coarse − floor on the cells of fully covered coarse cells (which carry the floor
+        themselves, see :attr:`coarse_floor`; floor 0 unless the overlap is trimmed), −α_fine
+        on those of partly covered ones (see :attr:`covered_coarse_cells`).
         """
         covered = self.covered_coarse_cells[self.overlap.coarse_cells]
-        weight = np.where(covered[:, None], self.alpha_coarse_overlap, -self.alpha_fine_overlap)
+        inside = self.alpha_coarse_overlap
+        if self.coarse_floor:
+            inside = inside - self.coarse_floor
+        return np.where(covered[:, None], inside, -self.alpha_fine_overlap)
+
+    def coarse_overlap_term(self) -> BlockTerm:
+        """The coarse model's contribution inside the overlap, integrated on the overlap cells
+        with :meth:`coarse_overlap_weight`."""
+        weight = self.coarse_overlap_weight()
         return BlockTerm(self.integration_model, weight, self.coarse_transfer, 1.0)
 
     def fine_term(self) -> BlockTerm:

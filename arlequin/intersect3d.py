@@ -1,14 +1,22 @@
 """Exact intersections of two tetrahedral meshes: each pair of overlapping cells' convex
 polyhedron, cut into tetrahedra (the integration mesh of a non-nested 3D patch).
 
-For a pair (a fine cell A, a coarse cell B), the vertices of A ∩ B are among 56 candidates: the
-4 + 4 vertices of A and B, and the 24 + 24 points where an edge of one crosses a face plane of the
-other; a candidate is a vertex if it lies in both cells (barycentric coordinates ≥ −tol). Each
-face of the polyhedron lies on one of the 8 face planes: its vertices are the candidates on that
-plane, ordered by angle about their centroid, duplicates dropped, and fanned into triangles (a
-plane both cells have, as on a common boundary, counted once); each triangle with the
-polyhedron's centroid makes one tetrahedron. The union of those tetrahedra is
-A ∩ B exactly (a convex polyhedron is the cone of its faces from any interior point).
+Each candidate pair (a fine cell A, a coarse cell B) is first classified from the barycentric
+coordinates of each cell's vertices in the other: *separated* when all vertices of one lie on
+the outer side of a face plane of the other (no volume in common: most bounding-box candidates),
+*contained* when all vertices of one lie in the other (A ∩ B is that cell: one tetrahedron, the
+most common case when the fine cells are several times smaller), and *cut* otherwise. Only cut
+pairs are clipped:
+
+the vertices of A ∩ B are among 56 candidates: the 4 + 4 vertices of A and B, and the 24 + 24
+points where an edge of one crosses a face plane of the other; a candidate is a vertex if it
+lies in both cells (barycentric coordinates ≥ −tol). Each face of the polyhedron lies on one
+of the 8 face planes: its vertices are the candidates on that plane, ordered by angle about
+their centroid, duplicates dropped, and fanned into triangles (a plane both cells have, as on a
+common boundary, counted once); each triangle with an apex makes one tetrahedron. The apex is
+one of the polyhedron's vertices, so the triangles of the faces through it are flat and
+dropped: a convex polyhedron is the cone of its other faces from any of its vertices (a prism
+cut from a tetrahedron by one plane gives 3 tetrahedra, against 8 from its centroid).
 
 Everything is vectorised over the pairs, in chunks of :data:`CHUNK` pairs (about 100 MB of
 temporaries); the candidate pairs come from a KD-tree on the coarse cells' centroids, filtered
@@ -20,7 +28,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-__all__ = ["CHUNK", "candidate_pairs", "tetrahedra_intersections"]
+__all__ = ["CHUNK", "candidate_pairs", "classify_pairs", "tetrahedra_intersections"]
 
 #: Cell pairs intersected at once.
 CHUNK = 8000
@@ -85,8 +93,38 @@ def _edge_plane_points(v: np.ndarray, lam: np.ndarray) -> tuple[np.ndarray, np.n
     return pts.reshape(len(v), 24, 3), crossing.reshape(len(v), 24)
 
 
+def classify_pairs(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Classify m pairs of tetrahedra a, b (m, 4, 3), see the module docstring.
+
+    Returns
+    -------
+    ndarray of int8, shape (m,)
+        0 separated (no common volume), 1 a inside b, 2 b inside a, 3 cut.
+    """
+    ga, ha = _barycentric_planes(a)
+    gb, hb = _barycentric_planes(b)
+    lam_b_at_a = np.einsum("mpj,mkj->mpk", a, gb) + hb[:, None]  # (m, 4 vertices, 4 planes)
+    lam_a_at_b = np.einsum("mpj,mkj->mpk", b, ga) + ha[:, None]
+    out = np.full(len(a), 3, dtype=np.int8)
+    out[np.all(lam_a_at_b >= -TOL, axis=(1, 2))] = 2
+    out[np.all(lam_b_at_a >= -TOL, axis=(1, 2))] = 1
+    separated = np.any(np.all(lam_b_at_a <= TOL, axis=1), axis=1)
+    separated |= np.any(np.all(lam_a_at_b <= TOL, axis=1), axis=1)
+    out[separated] = 0
+    return out
+
+
+def _positive(v: np.ndarray) -> np.ndarray:
+    """Tetrahedra v (k, 4, 3) with their last two vertices swapped where negatively oriented."""
+    e = v[:, 1:] - v[:, :1]
+    neg = np.einsum("kj,kj->k", np.cross(e[:, 0], e[:, 1]), e[:, 2]) < 0.0
+    v = v.copy()
+    v[neg] = v[neg][:, [0, 1, 3, 2]]
+    return v
+
+
 def _chunk(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Tetrahedra of A ∩ B for m pairs of cells a, b (m, 4, 3): (tets (k, 4, 3), pair (k,))."""
+    """Tetrahedra of A ∩ B for m cut pairs of cells a, b (m, 4, 3): (tets (k, 4, 3), pair (k,))."""
     m = len(a)
     ga, ha = _barycentric_planes(a)
     gb, hb = _barycentric_planes(b)
@@ -101,7 +139,8 @@ def _chunk(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     valid = np.concatenate([np.ones((m, 8), bool), va, vb], axis=1)
     valid &= np.all(lam >= -TOL, axis=2)
     n_valid = valid.sum(axis=1)
-    centre = np.einsum("mp,mpj->mj", valid.astype(float), pts) / np.maximum(n_valid, 1)[:, None]
+    # the apex of the cones: a vertex of the polyhedron (every valid candidate is one)
+    centre = pts[np.arange(m), np.argmax(valid, axis=1)]
     # the faces: candidates on each of the 8 planes
     on = valid[:, :, None] & (np.abs(lam) <= TOL)  # (m, 56, 8)
     on = np.transpose(on, (0, 2, 1))  # (m, 8, 56)
@@ -149,6 +188,8 @@ def _chunk(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def tetrahedra_intersections(fine_cells: np.ndarray, coarse_cells: np.ndarray,
+                             pairs: tuple[np.ndarray, np.ndarray] | None = None,
+                             backend: str = "numba",
                              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
     """The tetrahedra of every non-empty intersection of a fine and a coarse cell.
 
@@ -156,6 +197,11 @@ def tetrahedra_intersections(fine_cells: np.ndarray, coarse_cells: np.ndarray,
     ----------
     fine_cells, coarse_cells : ndarray, shape (n, 4, 3)
         Vertex coordinates (m) of the two meshes' tetrahedra.
+    pairs : (ndarray of int, ndarray of int), optional
+        The candidate pairs (fine, coarse) to intersect; default :func:`candidate_pairs`.
+    backend : {"numba", "numpy"}
+        The cut pairs clipped by the compiled kernel (:mod:`arlequin.clip3d`) or by the numpy
+        path of this module (its reference: the same pieces, tetrahedralised alike).
 
     Returns
     -------
@@ -164,14 +210,33 @@ def tetrahedra_intersections(fine_cells: np.ndarray, coarse_cells: np.ndarray,
     fine, coarse : ndarray of int, shape (k,)
         The fine and the coarse cell each lies in.
     """
-    fi, ci = candidate_pairs(fine_cells, coarse_cells)
+    if backend not in ("numba", "numpy"):
+        raise ValueError(f"backend must be 'numba' or 'numpy', got {backend!r}")
+    clip = _chunk
+    if backend == "numba":
+        from .clip3d import clip_pairs
+
+        def clip(a, b):
+            return clip_pairs(a, b, TOL)
+
+    fi, ci = candidate_pairs(fine_cells, coarse_cells) if pairs is None else pairs
     out_t, out_f, out_c = [], [], []
-    for start in range(0, fi.size, CHUNK):
-        f, c = fi[start : start + CHUNK], ci[start : start + CHUNK]
-        tets, pair = _chunk(fine_cells[f], coarse_cells[c])
-        out_t.append(tets)
-        out_f.append(f[pair])
-        out_c.append(c[pair])
+    for start in range(0, fi.size, 4 * CHUNK):
+        f, c = fi[start : start + 4 * CHUNK], ci[start : start + 4 * CHUNK]
+        kind = classify_pairs(fine_cells[f], coarse_cells[c])
+        for which, cells in ((1, fine_cells), (2, coarse_cells)):  # one cell inside the other
+            sel = kind == which
+            out_t.append(_positive(cells[f[sel] if which == 1 else c[sel]]))
+            out_f.append(f[sel])
+            out_c.append(c[sel])
+        cut = kind == 3
+        f, c = f[cut], c[cut]
+        for lo in range(0, f.size, CHUNK):
+            fc, cc = f[lo : lo + CHUNK], c[lo : lo + CHUNK]
+            tets, pair = clip(fine_cells[fc], coarse_cells[cc])
+            out_t.append(tets)
+            out_f.append(fc[pair])
+            out_c.append(cc[pair])
     if not out_t:
         return np.zeros((0, 4, 3)), np.zeros(0, np.int64), np.zeros(0, np.int64)
     return np.concatenate(out_t), np.concatenate(out_f), np.concatenate(out_c)

@@ -30,6 +30,7 @@ cells have no exact intersection (use a nested patch).
 from __future__ import annotations
 
 import logging
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -40,9 +41,13 @@ from .dofs import vector_operator
 from .locate import LocateResult, cell_centroids, cell_sizes, locate_points
 from .reference import interpolation_matrix, map_to_physical
 
-__all__ = ["Overlap", "OverlapError", "build_overlap"]
+__all__ = ["Overlap", "OverlapError", "PairFilter", "build_overlap", "check_meshes"]
 
 logger = logging.getLogger(__name__)
+
+
+#: ``pair_filter(fine_cells, coarse_cells) -> keep``: which candidate pairs to intersect.
+PairFilter = Callable[[np.ndarray, np.ndarray], np.ndarray]
 
 
 class OverlapError(ValueError):
@@ -63,6 +68,9 @@ class Overlap:
     coarse_cells, fine_cells : ndarray of int, shape (n_I_cells,)
         The coarse and fine cell containing each cell of I.
     method : {"nested", "merged", "intersection"}
+    trimmed : bool
+        The intersection was restricted to the pairs of cells a ``pair_filter`` kept (I does
+        not cover the whole overlap; see :func:`build_overlap`).
     """
 
     coarse_mesh: Mesh
@@ -73,6 +81,7 @@ class Overlap:
     coarse_cells: np.ndarray
     fine_cells: np.ndarray
     method: str
+    trimmed: bool = False
 
     def vector_transfer(self, which: str, n_components: int) -> sp.csr_matrix:
         """Transfer for vector fields with node-interleaved dofs (``d * node + component``).
@@ -144,7 +153,20 @@ def _is_nested(coarse: Mesh, fine: Mesh, p_coarse: sp.csr_matrix, tol: float) ->
     return bool(mismatch <= 1e-10 * np.max(np.abs(z)))
 
 
-def build_overlap(coarse: Mesh, fine: Mesh, method: str = "auto", tol: float = 0.05) -> Overlap:
+def check_meshes(coarse: Mesh, fine: Mesh) -> None:
+    """Raise :class:`OverlapError` unless the two meshes have one dimension and one cell type."""
+    if coarse.dim() != fine.dim():
+        raise OverlapError(
+            f"mismatched dimensions: coarse mesh is {coarse.dim()}D, patch mesh is {fine.dim()}D"
+        )
+    if coarse.t.shape[0] != fine.t.shape[0]:
+        raise OverlapError(
+            f"mismatched cell types: coarse {type(coarse).__name__}, patch {type(fine).__name__}"
+        )
+
+
+def build_overlap(coarse: Mesh, fine: Mesh, method: str = "auto", tol: float = 0.05,
+                  pair_filter: PairFilter | None = None) -> Overlap:  # fmt: skip
     """Build the integration mesh and transfer operators of a patch over a coarse mesh.
 
     Parameters
@@ -159,6 +181,12 @@ def build_overlap(coarse: Mesh, fine: Mesh, method: str = "auto", tol: float = 0
     tol : float
         Boundary tolerance as a fraction of the local coarse cell size: fine nodes farther than
         this outside the coarse mesh are an error.
+    pair_filter : callable, optional
+        ``pair_filter(fine_cells, coarse_cells) -> keep`` (int arrays of the candidate pairs ->
+        bool array): the non-nested intersections (2D and 3D) cut only the pairs it keeps, and
+        the overlap is marked ``trimmed``. A patch coupling uses it to skip the pieces on which
+        its weights are constant (:class:`~arlequin.gluing.PatchCoupling`). Ignored by nested
+        and 1D overlaps.
 
     Raises
     ------
@@ -169,14 +197,7 @@ def build_overlap(coarse: Mesh, fine: Mesh, method: str = "auto", tol: float = 0
         raise ValueError(
             f"overlap method must be 'auto', 'nested' or 'intersection', got {method!r}"
         )
-    if coarse.dim() != fine.dim():
-        raise OverlapError(
-            f"mismatched dimensions: coarse mesh is {coarse.dim()}D, patch mesh is {fine.dim()}D"
-        )
-    if coarse.t.shape[0] != fine.t.shape[0]:
-        raise OverlapError(
-            f"mismatched cell types: coarse {type(coarse).__name__}, patch {type(fine).__name__}"
-        )
+    check_meshes(coarse, fine)
     loc = _located(coarse, fine.p, tol, "patch mesh outside the coarse mesh")
     p_coarse = interpolation_matrix(coarse, loc.cells, loc.ref)
     if method == "nested" or (method == "auto" and _is_nested(coarse, fine, p_coarse, tol)):
@@ -194,9 +215,9 @@ def build_overlap(coarse: Mesh, fine: Mesh, method: str = "auto", tol: float = 0
     if isinstance(fine, MeshLine):
         return _merged_1d(coarse, fine, tol)
     if isinstance(fine, MeshTri):
-        return _intersection_2d(coarse, fine)
+        return _intersection_2d(coarse, fine, pair_filter)
     if isinstance(fine, MeshTet):
-        return _intersection_3d(coarse, fine)
+        return _intersection_3d(coarse, fine, pair_filter)
     raise OverlapError(
         f"non-nested overlap of {type(fine).__name__} meshes is not supported (exact intersection "
         "exists for 1D lines, 2D triangles and 3D tetrahedra); build the patch by refining "
@@ -237,7 +258,7 @@ def _simplex_ref(mesh: Mesh, cells: np.ndarray, x: np.ndarray) -> np.ndarray:
     return np.linalg.solve(jac, rhs)[..., 0].T
 
 
-def _intersection_2d(coarse: Mesh, fine: Mesh) -> Overlap:
+def _intersection_2d(coarse: Mesh, fine: Mesh, pair_filter: PairFilter | None) -> Overlap:
     import shapely
 
     if not isinstance(coarse, MeshTri):
@@ -246,6 +267,9 @@ def _intersection_2d(coarse: Mesh, fine: Mesh) -> Overlap:
     cpoly = shapely.polygons(np.transpose(coarse.p[:, coarse.t], (2, 1, 0)))
     tree = shapely.STRtree(cpoly)
     fi, ci = tree.query(fpoly, predicate="intersects")
+    if pair_filter is not None:
+        keep = np.asarray(pair_filter(fi, ci), dtype=bool)
+        fi, ci = fi[keep], ci[keep]
     inter = shapely.intersection(fpoly[fi], cpoly[ci])
     area = shapely.area(inter)
     fine_area = shapely.area(fpoly)
@@ -295,17 +319,22 @@ def _intersection_2d(coarse: Mesh, fine: Mesh) -> Overlap:
         ci[poly_of_tri],
         fi[poly_of_tri],
         "intersection",
+        pair_filter is not None,
     )
 
 
-def _intersection_3d(coarse: Mesh, fine: Mesh) -> Overlap:
-    from .intersect3d import tetrahedra_intersections
+def _intersection_3d(coarse: Mesh, fine: Mesh, pair_filter: PairFilter | None) -> Overlap:
+    from .intersect3d import candidate_pairs, tetrahedra_intersections
 
     if not isinstance(coarse, MeshTet):
         raise OverlapError("non-nested 3D overlaps need tetrahedral meshes on both sides")
-    tets, fcell, ccell = tetrahedra_intersections(
-        np.transpose(fine.p[:, fine.t], (2, 1, 0)), np.transpose(coarse.p[:, coarse.t], (2, 1, 0))
-    )
+    fcoords = np.transpose(fine.p[:, fine.t], (2, 1, 0))
+    ccoords = np.transpose(coarse.p[:, coarse.t], (2, 1, 0))
+    fi, ci = candidate_pairs(fcoords, ccoords)
+    if pair_filter is not None:
+        keep = np.asarray(pair_filter(fi, ci), dtype=bool)
+        fi, ci = fi[keep], ci[keep]
+    tets, fcell, ccell = tetrahedra_intersections(fcoords, ccoords, pairs=(fi, ci))
     n = tets.shape[0]
     if n == 0:
         raise OverlapError("the patch mesh does not intersect the coarse mesh")
@@ -316,4 +345,4 @@ def _intersection_3d(coarse: Mesh, fine: Mesh) -> Overlap:
     p_fine = interpolation_matrix(fine, fnodes, _simplex_ref(fine, fnodes, p))
     logger.info("intersection overlap: %d tetrahedra for %d patch cells", n, fine.nelements)
     return Overlap(coarse, fine, mesh, p_coarse.tocsr(), p_fine.tocsr(), ccell, fcell,
-                   "intersection")  # fmt: skip
+                   "intersection", pair_filter is not None)  # fmt: skip

@@ -247,19 +247,23 @@ class ArlequinProblem:
         cmodel = self.coarse
         if "coarse" in want:
             if load.kind == "body":
-                f = cmodel.body_force_vector(load.value)
+                # as the stiffness and mass: the coarse cells' own weights, then the overlaps'
+                f = cmodel.body_force_vector(load.value, weight=self._coarse_own_weight())
+                for pc in self.couplings:
+                    f = f + pc.coarse_transfer.T @ pc.integration_model.body_force_vector(
+                        load.value, weight=pc.coarse_overlap_weight()
+                    )
             else:
+                # the whole boundary, less α_fine on the overlap's facets there (every piece
+                # of a coarse cell on the boundary is kept, also in a trimmed overlap)
                 f = cmodel.traction_vector(self._facets(cmodel.mesh, load.where), load.value)
-            for pc in self.couplings:
-                imodel = pc.integration_model
-                if load.kind == "body":
-                    corr = imodel.body_force_vector(load.value, weight=pc.alpha_fine_overlap)
-                else:
+                for pc in self.couplings:
+                    imodel = pc.integration_model
                     facets = self._filter(imodel.mesh, pc.integration_boundary_facets(), load.where)
                     corr = imodel.traction_vector(
                         facets, load.value, weight=pc.weight_function("fine")
                     )
-                f = f - pc.coarse_transfer.T @ corr
+                    f = f - pc.coarse_transfer.T @ corr
             out["coarse"] = f
         for pc in self.couplings:
             if pc.name not in want:
@@ -284,14 +288,19 @@ class ArlequinProblem:
             return facets
         return facets[np.asarray(where(_facet_midpoints(mesh, facets)), dtype=bool)]
 
+    def _coarse_own_weight(self) -> np.ndarray:
+        """Weight of the coarse model's own term at its quadrature points, (n_elems, n_qp): 1,
+        except on the coarse cells a patch covers (0, or the floor a trimmed overlap leaves
+        them: :attr:`PatchCoupling.coarse_floor`)."""
+        own = np.ones(self.coarse.mesh.nelements)
+        for pc in self.couplings:
+            own[pc.covered_coarse_cells] = pc.coarse_floor
+        return np.repeat(own[:, None], self.coarse.scalar_basis().dx.shape[1], axis=1)
+
     def system(self) -> CoupledSystem:
         """The coupled algebraic system (blocks, coupling and Dirichlet constraints, loads)."""
         couplings = self.couplings
-        own = np.ones(self.coarse.mesh.nelements)
-        for pc in couplings:
-            own[pc.covered_coarse_cells] = 0.0
-        own_weight = np.repeat(own[:, None], self.coarse.scalar_basis().dx.shape[1], axis=1)
-        coarse_terms = [BlockTerm(self.coarse, own_weight)]
+        coarse_terms = [BlockTerm(self.coarse, self._coarse_own_weight())]
         coarse_terms += [pc.coarse_overlap_term() for pc in couplings]
         blocks = [Block("coarse", self.coarse, coarse_terms)]
         blocks += [Block(pc.name, pc.fine_model, [pc.fine_term()]) for pc in couplings]
@@ -328,15 +337,16 @@ class ArlequinProblem:
         the model whose space carries it."""
         cbasis = self.coarse.scalar_basis()
         c_measure = cbasis.dx.sum(axis=1)
-        fine_share = np.zeros(self.coarse.mesh.nelements)
+        # the coarse cells' weighted measure: their own term's, then the overlaps'
+        coarse_share = (self._coarse_own_weight() * cbasis.dx).sum(axis=1)
         blocks = []
         multipliers = {}
         for pc in self.couplings:
             ibasis = pc.integration_model.scalar_basis()
-            fine_share += np.bincount(
+            coarse_share += np.bincount(
                 pc.overlap.coarse_cells,
-                weights=(pc.alpha_fine_overlap * ibasis.dx).sum(axis=1),
-                minlength=fine_share.size,
+                weights=(pc.coarse_overlap_weight() * ibasis.dx).sum(axis=1),
+                minlength=coarse_share.size,
             )
             fdx = pc.fine_model.scalar_basis().dx
             alpha = (pc.alpha_fine * fdx).sum(axis=1) / fdx.sum(axis=1)
@@ -350,7 +360,7 @@ class ArlequinProblem:
             "coarse",
             self.coarse.mesh,
             int(self.coarse.n_components),
-            {"alpha": 1.0 - fine_share / c_measure},
+            {"alpha": coarse_share / c_measure},
         )
         return FieldLayout([coarse, *blocks], multipliers)
 

@@ -173,11 +173,28 @@ class LinearElastic:
         self.dim = dim
         self.scalar_element = scalar_element_for(mesh)
         self.element = ElementVector(self.scalar_element, dim=dim)
-        self.basis = Basis(mesh, self.element, intorder=self.intorder)
+        self._basis: Basis | None = None
+        self._scalar_basis: Basis | None = None
+
+    @property
+    def basis(self) -> Basis:
+        """Vector first-order basis with the model's quadrature, built on first use.
+
+        Lazy because it is the model's largest object (12 functions with their gradients at
+        every quadrature point of a tetrahedral mesh: 1.4 GB at 200k cells), and a model used
+        only to weigh or measure (an overlap's integration model before assembly) never needs
+        it.
+        """
+        if self._basis is None:
+            self._basis = Basis(self.mesh, self.element, intorder=self.intorder)
+        return self._basis
 
     def scalar_basis(self) -> Basis:
-        """Scalar first-order basis with the model's quadrature (weights at quadrature points)."""
-        return self.basis.with_element(self.scalar_element)
+        """Scalar first-order basis with the model's quadrature (weights at quadrature points),
+        built once (the same quadrature as :attr:`basis`)."""
+        if self._scalar_basis is None:
+            self._scalar_basis = Basis(self.mesh, self.scalar_element, intorder=self.intorder)
+        return self._scalar_basis
 
     # ------------------------------------------------------------------ construction helpers
     def with_mesh(self, mesh: Mesh) -> LinearElastic:
@@ -191,7 +208,7 @@ class LinearElastic:
     @property
     def n_dofs(self) -> int:
         """Number of displacement degrees of freedom."""
-        return int(self.basis.N)
+        return int(self.dim * self.mesh.nvertices)
 
     @property
     def n_components(self) -> int:
@@ -204,7 +221,9 @@ class LinearElastic:
 
     def nodal_dofs(self) -> np.ndarray:
         """Dof indices per node, shape (dim, n_nodes)."""
-        return self.basis.nodal_dofs
+        # interleaved by node (scikit-fem's ElementVector order), without building the basis
+        n = self.mesh.nvertices
+        return np.arange(self.dim * n).reshape(n, self.dim).T
 
     def dofs_where(self, where: Callable[[np.ndarray], np.ndarray], components=None) -> np.ndarray:
         """Dofs of the nodes ``x`` (shape (dim, n)) where ``where(x)`` is true.
@@ -218,7 +237,7 @@ class LinearElastic:
         """
         nodes = np.nonzero(np.asarray(where(self.mesh.p), dtype=bool))[0]
         comps = range(self.dim) if components is None else list(components)
-        return np.sort(self.basis.nodal_dofs[list(comps)][:, nodes].ravel())
+        return np.sort(self.nodal_dofs()[list(comps)][:, nodes].ravel())
 
     # ------------------------------------------------------------------ weights
     def weight_at_quadrature(self, weight: WeightLike, basis=None) -> np.ndarray:
@@ -406,7 +425,7 @@ class LinearElastic:
     def nodal_stress(self, u: np.ndarray) -> np.ndarray:
         """Stress recovered at the nodes by lumped L2 projection, shape (3, 3, n_nodes) (Pa)."""
         sq = self.stress_at_quadrature(u)
-        sbasis = self.basis.with_element(self.scalar_element)
+        sbasis = self.scalar_basis()
 
         @BilinearForm
         def mass(u_, v_, w):

@@ -125,7 +125,7 @@ class FiniteStrainJ2:
         self.elastic = LinearElastic(mesh, material.elastic, kind, intorder=self.intorder, **checks)
         self.basis = self.elastic.basis
         self.kin = Q1Kinematics(
-            mesh, kind, self.elastic.scalar_basis(), self.elastic.basis.nodal_dofs
+            mesh, kind, self.elastic.scalar_basis(), self.elastic.nodal_dofs()
         )
         # the compiled kernels: planar Q1 (j2_kernel) and 8-node hexahedra (j2_kernel_3d)
         compiled = material.law.kernel_code is not None

@@ -78,3 +78,21 @@ def test_scalar_l2_gram_sums_to_gluing_measure(dim, mesh, mediator):
     ones_m = np.ones(cm.n_multipliers)
     assert ones_m @ (cm.coarse @ ones_c) == pytest.approx(measure, rel=1e-12)
     assert ones_m @ (cm.fine @ ones_f) == pytest.approx(measure, rel=1e-12)
+
+
+@pytest.mark.parametrize("dim,mesh", [("2", "nested"), ("2", "nonnested"), ("3", "nested"),
+                                      ("3", "nonnested")])  # fmt: skip
+@pytest.mark.parametrize("coupling", ["L2", "H1"])
+def test_closed_form_gram_is_the_quadrature(dim, mesh, coupling):
+    # the closed form of P1 simplices against scikit-fem's quadrature of the same form (order
+    # 2: exact for products of two P1 functions), to round-off
+    from arlequin.coupling import gram_matrix
+
+    problem, _ = build_patch_test_problem(dim, coupling, "ramp", "coarse", mesh, seed=4)
+    pc = problem.couplings[0]
+    d = int(dim)
+    args = (pc.overlap, pc.gluing_cells, d, coupling, 0.37 * pc.gluing_width)
+    closed = gram_matrix(*args, intorder=2)
+    quadrature = gram_matrix(*args, intorder=2, closed_form=False)
+    scale = abs(quadrature).max()
+    assert abs(closed - quadrature).max() <= 1e-13 * scale
