@@ -22,7 +22,7 @@ import math
 import numba as nb
 import numpy as np
 
-__all__ = ["MAX_TETS", "clip_pairs"]
+__all__ = ["MAX_TETS", "clip_pairs", "warm_up"]
 
 #: Faces of the clipped polyhedron at most (A's four and one cap per plane of B).
 _MAX_FACES = 8
@@ -247,3 +247,9 @@ def clip_pairs(a: np.ndarray, b: np.ndarray, tol: float) -> tuple[np.ndarray, np
     pair = np.repeat(np.arange(m), counts)
     slot = np.arange(pair.size) - np.repeat(np.cumsum(counts) - counts, counts)
     return out[pair, slot], pair
+
+
+def warm_up() -> None:
+    """Compile (or load from the cache) the kernel on one pair."""
+    a = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+    clip_pairs(a[None], (a + 0.25)[None], 1e-10)

@@ -25,7 +25,7 @@ import scipy.sparse as sp
 from skfem import Basis, BilinearForm, ElementVector
 from skfem.helpers import dot, grad
 
-from .dofs import node_dofs
+from .dofs import node_dofs, vector_operator
 from .overlap import Overlap
 from .reference import scalar_element_for
 
@@ -117,40 +117,91 @@ def _is_simplex(mesh) -> bool:
     return mesh.t.shape[0] == mesh.dim() + 1 and mesh.dim() >= 2
 
 
-def _simplex_gram(mesh, cells: np.ndarray, ell2: float) -> sp.csr_matrix:
-    """The L2/H1 Gram matrix of vector P1 functions on simplices, in closed form.
+def _simplex_local(mesh, cells: np.ndarray, ell2: float) -> tuple[np.ndarray, np.ndarray]:
+    """Closed-form local Gram matrices of vector P1 functions on simplices.
 
     On a simplex T of measure |T| with barycentric gradients g_a (constant),
     ∫_T φ_a φ_b = |T| (1 + δ_ab) / ((d + 1)(d + 2)) and
-    ε(φ_a e_i) : ε(φ_b e_j) = ½ (δ_ij g_a·g_b + g_a,j g_b,i): the same matrix as the quadrature
-    of :func:`gram_matrix`'s form (tested to round-off), without the (12 × 12 functions ×
-    quadrature points) arrays of a vector basis, in chunks of cells (bounded memory).
+    ε(φ_a e_i) : ε(φ_b e_j) = ½ (δ_ij g_a·g_b + g_a,j g_b,i): the same matrices as the
+    quadrature of :func:`gram_matrix`'s form (tested to round-off), without the
+    (functions² × quadrature points) arrays of a vector basis.
+
+    Returns
+    -------
+    local : ndarray, shape (m, d + 1, d, d + 1, d)
+        Entry (a, i, b, j): node a component i against node b component j.
+    dofs : ndarray of int, shape (m, d + 1, d)
+        The interleaved dofs d·node + i of the integration mesh.
     """
     d = mesh.dim()
     nv = d + 1
-    n = d * mesh.nvertices
-    out = sp.csr_matrix((n, n))
     mass_ref = (np.ones((nv, nv)) + np.eye(nv)) / ((d + 1) * (d + 2))
     eye = np.eye(d)
+    x = np.transpose(mesh.p[:, mesh.t[:, cells]], (2, 1, 0))  # (m, nv, d)
+    jac = np.transpose(x[:, 1:] - x[:, :1], (0, 2, 1))  # columns x_k − x_0
+    vol = np.abs(np.linalg.det(jac)) / {2: 2.0, 3: 6.0}[d]
+    inv = np.linalg.inv(jac)  # rows: gradients of λ_1..λ_d
+    g = np.concatenate([-inv.sum(axis=1, keepdims=True), inv], axis=1)  # (m, nv, d)
+    local = np.einsum("m,ab,ij->maibj", vol, mass_ref, eye)
+    if ell2:
+        gg = np.einsum("mak,mbk->mab", g, g)
+        local += 0.5 * ell2 * vol[:, None, None, None, None] * (
+            np.einsum("mab,ij->maibj", gg, eye) + np.einsum("maj,mbi->maibj", g, g)
+        )
+    dofs = d * mesh.t[:, cells].T[:, :, None] + np.arange(d)  # (m, nv, d)
+    return local, dofs
+
+
+def _local_csr(local: np.ndarray, dofs: np.ndarray, n: int) -> sp.csr_matrix:
+    rows = np.broadcast_to(dofs[:, :, :, None, None], local.shape)
+    cols = np.broadcast_to(dofs[:, None, None, :, :], local.shape)
+    return sp.csr_matrix((local.ravel(), (rows.ravel(), cols.ravel())), shape=(n, n))
+
+
+def _simplex_gram(mesh, cells: np.ndarray, ell2: float) -> sp.csr_matrix:
+    """The L2/H1 Gram matrix of vector P1 functions on simplices, in closed form
+    (:func:`_simplex_local`), chunk by chunk of cells."""
+    n = mesh.dim() * mesh.nvertices
+    out = sp.csr_matrix((n, n))
     for start in range(0, cells.size, _GRAM_CHUNK):
-        c = cells[start : start + _GRAM_CHUNK]
-        x = np.transpose(mesh.p[:, mesh.t[:, c]], (2, 1, 0))  # (m, nv, d)
-        jac = np.transpose(x[:, 1:] - x[:, :1], (0, 2, 1))  # columns x_k − x_0
-        vol = np.abs(np.linalg.det(jac)) / {2: 2.0, 3: 6.0}[d]
-        inv = np.linalg.inv(jac)  # rows: gradients of λ_1..λ_d
-        g = np.concatenate([-inv.sum(axis=1, keepdims=True), inv], axis=1)  # (m, nv, d)
-        # local (a, i, b, j)
-        local = np.einsum("m,ab,ij->maibj", vol, mass_ref, eye)
-        if ell2:
-            gg = np.einsum("mak,mbk->mab", g, g)
-            local += 0.5 * ell2 * vol[:, None, None, None, None] * (
-                np.einsum("mab,ij->maibj", gg, eye) + np.einsum("maj,mbi->maibj", g, g)
-            )
-        dofs = d * mesh.t[:, c].T[:, :, None] + np.arange(d)  # (m, nv, d): d·node + i
-        rows = np.broadcast_to(dofs[:, :, :, None, None], local.shape)
-        cols = np.broadcast_to(dofs[:, None, None, :, :], local.shape)
-        out = out + sp.csr_matrix((local.ravel(), (rows.ravel(), cols.ravel())), shape=(n, n))
+        local, dofs = _simplex_local(mesh, cells[start : start + _GRAM_CHUNK], ell2)
+        out = out + _local_csr(local, dofs, n)
     return out
+
+
+def _simplex_coupling(overlap: Overlap, cells: np.ndarray, ell2: float, mediator: str
+                      ) -> tuple[sp.csr_matrix, sp.csr_matrix, np.ndarray]:  # fmt: skip
+    """C_coarse, C_fine and the mediator dofs on simplices, chunk by chunk of gluing cells.
+
+    Zᵀ G P of :func:`coupling_matrices` without the integration mesh's global Gram matrix
+    nor its global vector transfers (at a million integration cells those are the build's
+    largest objects): each chunk's Gram matrix on its own nodes, numbered locally, and the
+    rows of the transfers at those nodes only.
+    """
+    mesh = overlap.integration_mesh
+    d = mesh.dim()
+    pc, pf = overlap.coarse_transfer.tocsr(), overlap.fine_transfer.tocsr()
+    pm = pc if mediator == "coarse" else pf
+    gluing_nodes = np.unique(mesh.t[:, cells])
+    support = np.asarray(abs(pm[gluing_nodes]).max(axis=0).todense()).ravel() > 1e-12
+    mediator_dofs = node_dofs(np.nonzero(support)[0], d).T.ravel()
+    mediator_dofs.sort()
+    if mediator_dofs.size == 0:
+        raise MediatorError(f"the {mediator} mediator space has no support on the gluing zone")
+    c_coarse = sp.csr_matrix((mediator_dofs.size, d * pc.shape[1]))
+    c_fine = sp.csr_matrix((mediator_dofs.size, d * pf.shape[1]))
+    for start in range(0, cells.size, _GRAM_CHUNK):
+        local, dofs = _simplex_local(mesh, cells[start : start + _GRAM_CHUNK], ell2)
+        nodes, renum = np.unique(dofs[:, :, 0] // d, return_inverse=True)
+        local_dofs = d * renum.reshape(dofs.shape[:2])[:, :, None] + np.arange(d)
+        gram = _local_csr(local, local_dofs, d * nodes.size)
+        vc = vector_operator(pc[nodes], d)
+        vf = vector_operator(pf[nodes], d)
+        z = (vc if mediator == "coarse" else vf)[:, mediator_dofs]
+        zt_g = (z.T @ gram).tocsr()
+        c_coarse = c_coarse + zt_g @ vc
+        c_fine = c_fine + zt_g @ vf
+    return c_coarse.tocsr(), c_fine.tocsr(), mediator_dofs
 
 
 #: Cells of one chunk of the closed-form Gram matrix (about 150 MB of temporaries in 3D).
@@ -194,6 +245,17 @@ def coupling_matrices(
     if intorder is None:
         # products of two first-order functions (times r in axisymmetry) are integrated exactly
         intorder = 3 if axisymmetric else 2
+    mesh = overlap.integration_mesh
+    cells = np.asarray(gluing_cells, dtype=np.int64)
+    if _is_simplex(mesh) and not axisymmetric and mesh.dim() == n_components and cells.size:
+        if coupling not in ("L2", "H1"):
+            raise ValueError(f"coupling must be 'L2' or 'H1', got {coupling!r}")
+        if coupling == "H1" and not (length or 0.0) > 0.0:
+            raise ValueError(f"H1 coupling needs a positive length, got length={length}")
+        ell2 = float(length) ** 2 if coupling == "H1" else 0.0
+        coarse, fine, mediator_dofs = _simplex_coupling(overlap, cells, ell2, mediator)
+        return CouplingMatrices(coarse, fine, mediator_dofs, mediator, coupling,
+                                float(length or 0.0) if coupling == "H1" else 0.0)  # fmt: skip
     gram = gram_matrix(
         overlap, gluing_cells, n_components, coupling, length or 0.0, axisymmetric, intorder
     )

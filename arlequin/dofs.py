@@ -48,9 +48,21 @@ def vector_operator(scalar: sp.spmatrix, n_components: int) -> sp.csr_matrix:
     ``scalar`` maps nodal values of one mesh to nodal values of another, shape (m, n); the result
     maps interleaved vector fields, shape (n_components m, n_components n).
     """
-    if n_components == 1:
-        return sp.csr_matrix(scalar)
-    return sp.kron(scalar, sp.identity(n_components, format="csr"), format="csr")
+    a = sp.csr_matrix(scalar)
+    d = int(n_components)
+    if d == 1:
+        return a
+    # kron(scalar, I_d) built from the CSR arrays (scipy's kron goes through COO: 3 s for the
+    # 16M entries of a 200k-tetrahedron overlap's transfer): row d·i + c holds row i's entries
+    # at columns d·j + c, in the same order, so the result is kron's entry for entry
+    m, n = a.shape
+    counts = np.repeat(np.diff(a.indptr), d)
+    indptr = np.zeros(d * m + 1, dtype=np.int64)
+    np.cumsum(counts, out=indptr[1:])
+    row = np.repeat(np.arange(d * m), counts)
+    src = a.indptr[row // d] + (np.arange(indptr[-1]) - indptr[row])
+    indices = d * a.indices[src].astype(np.int64) + row % d
+    return sp.csr_matrix((a.data[src], indices, indptr), shape=(d * m, d * n))
 
 
 @dataclass(frozen=True)

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from skfem import Basis
 
+from .fields import scalar_at_quadrature
 from .reference import scalar_element_for
 
 if TYPE_CHECKING:
@@ -65,7 +66,7 @@ def _ramp_failures(pc: PatchCoupling) -> list[str]:
     cells = pc.gluing_cells
     basis = Basis(imesh, scalar_element_for(imesh), elements=cells, intorder=2)
     nodal = pc.overlap.fine_transfer @ pc._fine_nodal("coarse")
-    grad = np.asarray(basis.interpolate(nodal).grad)  # (d, nc, nq)
+    grad = scalar_at_quadrature(basis, nodal, gradient=True)  # (d, nc, nq)
     scale = float(np.max(np.abs(grad))) if grad.size else 0.0
     if scale == 0.0:
         return []

@@ -21,6 +21,7 @@ import scipy.sparse as sp
 
 from .coupling import CouplingMatrices, MediatorError, coupling_matrices
 from .exactness import ExactnessWarning, exactness_failures
+from .fields import scalar_at_quadrature
 from .geometry import distance_to_facets, facet_coordinates, outward_normals
 from .locate import cell_centroids, cell_sizes, locate_points
 from .overlap import Overlap, build_overlap, check_meshes
@@ -325,7 +326,7 @@ class PatchCoupling:
             nodal = self._fine_nodal(which)
             if overlap:
                 nodal = self.overlap.fine_transfer @ nodal
-            return np.asarray(basis.interpolate(nodal))
+            return scalar_at_quadrature(basis, nodal)
         if mode == "cell":
             per_cell = self._fine_cell_values(which)
             if overlap:

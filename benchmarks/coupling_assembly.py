@@ -210,6 +210,9 @@ def run_case(case: str, repeat: int = 3, profile: bool = False) -> dict:
         kind = "plane_strain" if dim == 2 else "3d"
         return LinearElastic(fine_mesh, IsotropicElastic(YOUNG, POISSON), kind=kind).stiffness()
 
+    from arlequin.clip3d import warm_up
+
+    warm_up()  # numba's compilation (or cache load) out of the timings
     k = skfem_model_order()
     times: dict[str, float] = {
         "skfem_stiffness_default_quadrature": _best_time(skfem_default, repeat),
