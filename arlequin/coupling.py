@@ -204,8 +204,8 @@ def _simplex_coupling(overlap: Overlap, cells: np.ndarray, ell2: float, mediator
     return c_coarse.tocsr(), c_fine.tocsr(), mediator_dofs
 
 
-#: Cells of one chunk of the closed-form Gram matrix (about 150 MB of temporaries in 3D).
-_GRAM_CHUNK = 100_000
+#: Cells of one chunk of the closed-form Gram matrix (about 100 MB of temporaries in 3D).
+_GRAM_CHUNK = 25_000
 
 
 def coupling_matrices(

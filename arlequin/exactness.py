@@ -64,7 +64,10 @@ def _ramp_failures(pc: PatchCoupling) -> list[str]:
     """Condition B for ramp weights: one weight gradient per mediator function."""
     imesh = pc.overlap.integration_mesh
     cells = pc.gluing_cells
-    basis = Basis(imesh, scalar_element_for(imesh), elements=cells, intorder=2)
+    # P1 gradients are constant on a simplex: one point each (a million integration cells of
+    # a non-nested 3D patch); bilinear ones vary: order 2
+    simplex = imesh.t.shape[0] == imesh.dim() + 1
+    basis = Basis(imesh, scalar_element_for(imesh), elements=cells, intorder=1 if simplex else 2)
     nodal = pc.overlap.fine_transfer @ pc._fine_nodal("coarse")
     grad = scalar_at_quadrature(basis, nodal, gradient=True)  # (d, nc, nq)
     scale = float(np.max(np.abs(grad))) if grad.size else 0.0

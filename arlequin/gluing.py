@@ -29,7 +29,7 @@ from .patches import Patch
 from .system import BlockTerm
 from .weights import PartitionWeights, check_partition_of_unity
 
-__all__ = ["ExactnessWarning", "PatchCoupling"]  # Patch: arlequin.patches (imported here too)
+__all__ = ["PatchCoupling"]  # Patch: arlequin.patches, ExactnessWarning: arlequin.exactness
 
 
 logger = logging.getLogger(__name__)

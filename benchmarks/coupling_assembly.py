@@ -32,7 +32,9 @@ For each, in one process:
 Wall times (s) are the best of ``--repeat`` runs (``time.perf_counter``); peak memory (bytes) is
 the ``tracemalloc`` peak of a separate run of each step (tracemalloc slows Python code down, so it
 is never on during the timed runs); ``maxrss`` is the process's peak resident set size (bytes,
-``resource.getrusage``), and each case runs in its own subprocess so that it is per case. The
+``resource.getrusage``), and each case runs in its own subprocess so that it is per case;
+``coupling_alone_maxrss_bytes`` is the peak of a child process that builds the meshes and the
+coupling only. The
 ratios are coupling time / assembly time and coupling peak / assembly peak; the target is ≤ 2
 for nested patches and ≤ 4 for non-nested ones (``within_target`` compares with scikit-fem's
 assembly at its default quadrature), and a peak resident memory ≤ 3 GB. A coupling
@@ -282,7 +284,18 @@ def run_case(case: str, repeat: int = 3, profile: bool = False) -> dict:
     )
     if profile:
         out["profile"] = _profile(coupling)
+    out["coupling_alone_maxrss_bytes"] = _coupling_alone_maxrss(case)
     return out
+
+
+def _coupling_alone_maxrss(case: str) -> int | None:
+    """Peak resident memory (bytes) of a child process that builds the meshes and the coupling
+    only (the process's own peak, no assembly before it)."""
+    cmd = [sys.executable, __file__, "--case", case, "--coupling-only"]
+    done = subprocess.run(cmd, capture_output=True, text=True)
+    if done.returncode != 0:
+        return None
+    return int(json.loads(done.stdout)["maxrss_bytes"])
 
 
 def _maxrss_bytes() -> int:
@@ -328,7 +341,14 @@ def main(argv: list[str] | None = None) -> dict:
         "--mem-limit-gb", type=float, default=16.0, help="address-space limit per case (GiB)"
     )
     parser.add_argument("--timeout", type=float, default=1800.0, help="time limit per case (s)")
+    parser.add_argument("--coupling-only", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
+    if args.coupling_only:  # the child of _coupling_alone_maxrss
+        coarse_mesh, fine_mesh, width = build_meshes(args.case)
+        make_problem(coarse_mesh, fine_mesh, width).couplings  # noqa: B018
+        result = {"maxrss_bytes": _maxrss_bytes()}
+        print(json.dumps(result))
+        return result
     if args.case == "all":
         result = {
             "python": platform.python_version(),
