@@ -81,15 +81,23 @@ class BlockTerm:
 
     The block's internal force is ``sum(sign * P.T @ model.internal_force(P @ u_block, weight))``
     over its terms. ``P`` (None = identity) maps the block's dofs to the term model's dofs; the
-    coarse model of an Arlequin problem has a term on its own mesh (weight 1) and, per patch, a
-    term with sign −1 on the overlap integration mesh weighted by α_fine, so that the net weight
-    inside the overlap is α_coarse = 1 − α_fine, integrated exactly on the overlap cells.
+    coarse model of an Arlequin problem has a term on its own mesh (weight 1 outside the
+    patches) and, per patch, a term on the overlap's integration mesh
+    (:meth:`~arlequin.gluing.PatchCoupling.coarse_overlap_weight`), so that the net weight inside
+    the overlap is α_coarse, integrated exactly on the overlap cells. An array weight is kept
+    as a read-only copy: models may then check and broadcast it once for all steps.
     """
 
     model: Any
     weight: Any = None
     transfer: sp.csr_matrix | None = None
     sign: float = 1.0
+
+    def __post_init__(self) -> None:
+        if isinstance(self.weight, np.ndarray):
+            w = np.array(self.weight, dtype=float)
+            w.setflags(write=False)
+            self.weight = w
 
     def _lift(self, a: sp.spmatrix) -> sp.csr_matrix:
         if self.transfer is None:

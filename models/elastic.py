@@ -175,6 +175,8 @@ class LinearElastic:
         self.element = ElementVector(self.scalar_element, dim=dim)
         self._basis: Basis | None = None
         self._scalar_basis: Basis | None = None
+        # scikit-fem's nvertices is a property computed on each call (28 µs): asked every step
+        self._n_nodes = int(mesh.nvertices)
 
     @property
     def basis(self) -> Basis:
@@ -208,7 +210,7 @@ class LinearElastic:
     @property
     def n_dofs(self) -> int:
         """Number of displacement degrees of freedom."""
-        return int(self.dim * self.mesh.nvertices)
+        return self.dim * self._n_nodes
 
     @property
     def n_components(self) -> int:
@@ -222,7 +224,7 @@ class LinearElastic:
     def nodal_dofs(self) -> np.ndarray:
         """Dof indices per node, shape (dim, n_nodes)."""
         # interleaved by node (scikit-fem's ElementVector order), without building the basis
-        n = self.mesh.nvertices
+        n = self._n_nodes
         return np.arange(self.dim * n).reshape(n, self.dim).T
 
     def dofs_where(self, where: Callable[[np.ndarray], np.ndarray], components=None) -> np.ndarray:

@@ -146,6 +146,7 @@ class FiniteStrainJ2:
         self._critical_ratio: np.ndarray | None = None
         self._kernel_static: tuple | None = None  # contiguous inputs and scratch of the kernel
         self._ones: np.ndarray | None = None
+        self._alpha_of: tuple | None = None  # (read-only weight, its checked broadcast)
 
     def _measure_factor(self) -> np.ndarray:
         if self.kind == "axisymmetric":
@@ -264,6 +265,12 @@ class FiniteStrainJ2:
             if self._ones is None:
                 self._ones = np.ones(self.shape)
             alpha = self._ones
+        elif isinstance(weight, np.ndarray) and not weight.flags.writeable:
+            # a read-only weight array cannot change between steps: checked and broadcast
+            # once (an integrator passes the same one at every step)
+            if self._alpha_of is None or self._alpha_of[0] is not weight:
+                self._alpha_of = (weight, self.elastic.weight_at_quadrature(weight))
+            alpha = self._alpha_of[1]
         else:
             alpha = self.elastic.weight_at_quadrature(weight)
         if state.plastic_work is None:  # a state built by hand: no work accumulated yet
