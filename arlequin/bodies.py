@@ -136,9 +136,10 @@ class MultiBodyProblem:
                 if not isinstance(c, LinearConstraint):
                     raise ContractError(f"body {b!r} has a constraint {c!r} that is not a "
                                         "LinearConstraint: give contact to the integrator")
+                pivots = None if c.pivot_dofs is None else c.pivot_dofs + offsets[b]
                 constraints.append(LinearConstraint(
                     _shift_columns(c.matrix, offsets[b], n), c.rhs, f"{b}{SEPARATOR}{c.name}",
-                    level=c.level, kind=c.kind))  # fmt: skip
+                    level=c.level, kind=c.kind, pivot_dofs=pivots))  # fmt: skip
         loaded = [(offsets[b], s) for b, s in systems.items() if s.load is not None]
 
         def load(t: float) -> np.ndarray:

@@ -311,10 +311,14 @@ class ArlequinProblem:
         for pc in couplings:
             cm = pc.coupling
             rows = dofmap.embed("coarse", cm.coarse) - dofmap.embed(pc.name, cm.fine)
-            rows = rows.tocsr()[np.nonzero(self.mediator_rows(pc))[0]]
-            constraints.append(
-                LinearConstraint(rows.tocsr(), None, f"coupling:{pc.name}", kind="coupling")
-            )
+            kept = np.nonzero(self.mediator_rows(pc))[0]
+            rows = rows.tocsr()[kept]
+            # a fine mediator's functions are the patch's own on the band: its dofs, one per
+            # row, are where the rows are square (the explicit scheme's impulse basis)
+            pivots = (dofmap[pc.name].slice.start + np.asarray(cm.mediator_dofs)[kept]
+                      if cm.mediator == "fine" else None)  # fmt: skip
+            constraints.append(LinearConstraint(rows.tocsr(), None, f"coupling:{pc.name}",
+                                                kind="coupling", pivot_dofs=pivots))  # fmt: skip
         for k, bc in enumerate(self._dirichlet):
             constraints.append(self._dirichlet_rows(bc, dofmap, k))
 

@@ -48,6 +48,14 @@ class LinearConstraint:
     kind : str
         ``"coupling"`` (Arlequin mediator rows: their work is the coupling work),
         ``"dirichlet"`` or ``"other"``.
+    pivot_dofs : ndarray of int, shape (m,), optional
+        A hint for the explicit scheme: global dofs, one per row, on which the rows form an
+        invertible square matrix T and which no other row touches (single-dof supports
+        aside). The scheme may then write the rows in the basis where they are the identity
+        on those dofs, T⁻¹B (the same constraint, the same corrected velocities), whose impulse
+        matrix is diagonal plus low rank
+        (:mod:`arlequin.integrators.row_basis`); the fine mediator of a nested patch gives its
+        band's fine dofs. Rows whose T⁻¹B is not sparse keep their own basis.
     """
 
     matrix: sp.csr_matrix
@@ -55,12 +63,24 @@ class LinearConstraint:
     name: str = "constraint"
     level: str = "displacement"
     kind: str = "other"
+    pivot_dofs: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         if self.level not in ("displacement", "velocity"):
             raise ValueError(
                 f"constraint level must be 'displacement' or 'velocity', got {self.level!r}"
             )
+        if self.pivot_dofs is not None:
+            piv = np.asarray(self.pivot_dofs)
+            if piv.shape != (self.n_rows,) or not np.issubdtype(piv.dtype, np.integer):
+                raise ValueError(
+                    f"pivot_dofs of constraint {self.name!r} must be {self.n_rows} integer dofs "
+                    f"(one per row), got an array of shape {piv.shape} and dtype {piv.dtype}"
+                )
+            n = int(self.matrix.shape[1])
+            if piv.size and (piv.min() < 0 or piv.max() >= n or np.unique(piv).size != piv.size):
+                raise ValueError(f"pivot_dofs of constraint {self.name!r} must be distinct dofs "
+                                 f"in [0, {n})")  # fmt: skip
 
     @property
     def n_rows(self) -> int:

@@ -111,3 +111,54 @@ def test_factor_rows_names_dependent_rows():
     b = sp.vstack([b, b[10]]).tocsr()  # row 10 twice: the split's A is singular, then S
     with pytest.raises(ConstraintError, match="linearly dependent"):
         factor_rows(b, inv_mass, "test rows", names=lambda i: f"row {i}")
+
+
+def _pivot_basis_rows(n_groups: int, n_rows: int, n_shared: int, seed: int = 0):
+    """Rows [I | P] in groups: row i of a group has a dof of its own and touches 2-4 of the
+    group's ``n_shared`` dofs (the interpolation of a coarse field), the groups apart."""
+    rng = np.random.default_rng(seed)
+    blocks = []
+    for _ in range(n_groups):
+        p = np.zeros((n_rows, n_shared))
+        for i in range(n_rows):
+            cols = rng.choice(n_shared, size=rng.integers(2, 5), replace=False)
+            p[i, cols] = -rng.uniform(0.1, 1.0, cols.size)
+        blocks.append(np.hstack([np.eye(n_rows), p]))
+    b = sp.block_diag(blocks, format="csr")
+    inv_mass = rng.uniform(0.5, 2.0, b.shape[1])
+    return b, inv_mass
+
+
+@pytest.mark.parametrize("n_groups", [1, 3])
+def test_factor_rows_diagonal_plus_low_rank(n_groups):
+    from arlequin.integrators.linalg import DiagonalLowRankSolver, RowGroupsSolver, factor_rows
+
+    b, inv_mass = _pivot_basis_rows(n_groups, n_rows=60, n_shared=12)
+    solver = factor_rows(b, inv_mass, "test rows")
+    if n_groups == 1:
+        assert isinstance(solver, DiagonalLowRankSolver) and solver.k == 12
+    else:
+        # one capacitance matrix a group (3 of 12 × 12, not one of 36 × 36)
+        assert isinstance(solver, RowGroupsSolver) and len(solver.solvers) == 3
+        assert all(isinstance(s, DiagonalLowRankSolver) and s.k == 12 for s in solver.solvers)
+    s = (b @ sp.diags(inv_mass) @ b.T).toarray()
+    rng = np.random.default_rng(4)
+    for rhs in (rng.standard_normal(b.shape[0]), rng.standard_normal((b.shape[0], 3))):
+        # Woodbury is exact: the dense solve to round-off (C's eigenvalues are at least 1)
+        assert np.allclose(solver.solve(rhs), np.linalg.solve(s, rhs), rtol=1e-12, atol=1e-14)
+
+
+def test_factor_rows_diagonal_path_needs_a_private_dof_in_every_row():
+    from arlequin.integrators.linalg import DiagonalLowRankSolver, factor_rows
+
+    b, inv_mass = _pivot_basis_rows(1, n_rows=40, n_shared=10)
+    # two rows share their own dofs: no longer private, the other paths take the rows
+    b = b.tolil()
+    b[1, 0] = 0.5
+    b[0, 1] = 0.5
+    b = b.tocsr()
+    solver = factor_rows(b, inv_mass, "test rows")
+    assert not isinstance(solver, DiagonalLowRankSolver)
+    s = (b @ sp.diags(inv_mass) @ b.T).toarray()
+    rhs = np.random.default_rng(5).standard_normal(b.shape[0])
+    assert np.allclose(solver.solve(rhs), np.linalg.solve(s, rhs), rtol=1e-11, atol=1e-13)

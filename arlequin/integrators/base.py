@@ -162,7 +162,7 @@ class Integrator:
                     f"constraint {c.name!r} prescribes multipliers (slip friction): it runs "
                     f"with the explicit integrator, not {self.name!r}"
                 )
-        self.rows = EqualityRows([c for c in all_constraints if not is_unilateral(c)], self.ops)
+        self.rows = self._equality_rows([c for c in all_constraints if not is_unilateral(c)])
         names = [c.name for c in self.unilateral] + list(self.rows.slices)
         if len(set(names)) != len(names):
             raise ValueError(f"constraint names must be unique, got {names}")
@@ -206,6 +206,10 @@ class Integrator:
         self._initialize()
 
     # ------------------------------------------------------------------ scheme hooks
+    def _equality_rows(self, constraints: list[LinearConstraint]) -> EqualityRows:
+        """The equality rows the scheme uses (the explicit one's in its impulse basis)."""
+        return EqualityRows(constraints, self.ops)
+
     def _default_controller(self) -> StepController:
         raise NotImplementedError
 
@@ -407,9 +411,8 @@ class Integrator:
     def _full_multipliers(self, lam_a: np.ndarray, idx: Sequence[np.ndarray]) -> list[np.ndarray]:
         return scatter_active(lam_a, idx, [c.n_rows for c in self.unilateral])
 
-    def _update_statuses(
-        self, trials: list[Any], u: np.ndarray, v: np.ndarray, lams: Sequence[np.ndarray]
-    ) -> tuple[list[Any], bool]:
+    def _update_statuses(self, trials: list[Any], u: np.ndarray, v: np.ndarray,
+                         lams: Sequence[np.ndarray]) -> tuple[list[Any], bool]:  # fmt: skip
         new = [c.update_status(tr, u, v, lam) for c, tr, lam in zip(self.unilateral, trials, lams)]
         return new, any(tr.changed for tr in new)
 
@@ -417,11 +420,8 @@ class Integrator:
         self.n_status_failures += 1
         logger.warning(
             "%s: unilateral statuses still changing after %d iterations at step %d, t = %.6e s",
-            self.name,
-            self.max_status_iterations,
-            self.step_count + 1,
-            t_new,
-        )
+            self.name, self.max_status_iterations, self.step_count + 1, t_new,
+        )  # fmt: skip
 
     def _commit_unilateral(
         self,

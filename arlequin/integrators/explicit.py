@@ -49,7 +49,8 @@ from .controllers import FixedStep, StepController
 from .damping import RayleighDamping
 from .impulses import ImpulseSolver
 from .registry import register
-from .rows import transposed, unilateral_block_powers
+from .row_basis import ImpulseBasis
+from .rows import EqualityRows, transposed, unilateral_block_powers
 from .stability import DEFAULT_SAFETY, StableStep, check_time_step, stable_time_step
 
 __all__ = ["DEFAULT_SAFETY", "CentralDifference"]
@@ -126,6 +127,12 @@ class CentralDifference(Integrator):
         self._f_applied: np.ndarray | None = None
         self.constraint_time = 0.0
         super().__init__(system, dt, **kwargs)
+
+    def _equality_rows(self, constraints) -> EqualityRows:
+        # constraints with pivot dofs in their identity basis: the same corrected velocities,
+        # a diagonal-plus-low-rank impulse matrix (row_basis); multipliers reported as given
+        self.row_basis = ImpulseBasis(constraints, self.ops)
+        return self.row_basis.rows
 
     # ------------------------------------------------------------------ stable step
     def _impulse_solver(self) -> ImpulseSolver:
@@ -313,7 +320,7 @@ class CentralDifference(Integrator):
         self._lam_a = lam_a
         self._g_a = g_a
         self._dt_bar = dt_bar
-        mult = self.rows.split(lam_e / dt_bar) if self.rows.m else {}
+        mult = self.row_basis.multipliers(lam_e / dt_bar) if self.rows.m else {}
         for c, lam in zip(self.unilateral, fulls):
             mult[c.name] = lam
         self.multipliers = mult

@@ -4,23 +4,29 @@ The matrices mix rows of very different units (stiffness N/m, mass kg, constrain
 L2 coupling): :class:`ScaledLU` scales them symmetrically before SuperLU and turns (numerical)
 singularity into a :class:`~arlequin.contract.ConstraintError` that names the offending row.
 :func:`factor_rows` factorises the impulse matrix B M⁻¹ Bᵀ of constraint rows, by
-:class:`LowRankSplitSolver` when a few dofs shared by many rows make it dense.
+:class:`LowRankSplitSolver` when a few dofs shared by many rows make it dense, or
+:class:`DiagonalLowRankSolver` when every row has a dof of its own (rows in their pivot basis,
+:mod:`arlequin.integrators.row_basis`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.linalg.lapack import dpotrf, dpotrs
+from scipy.sparse.csgraph import connected_components
 
 from ..contract import ConstraintError
 
 __all__ = [
+    "DiagonalLowRankSolver",
     "IsolatedRowsSolver",
     "LowRankSplitSolver",
+    "RowGroupsSolver",
     "ScaledLU",
     "dense_cho_factor",
     "dense_cho_solve",
@@ -274,16 +280,112 @@ class IsolatedRowsSolver:
         return x
 
 
+class DiagonalLowRankSolver:
+    """Solves (B M⁻¹ Bᵀ) x = r when every row has a column no other row touches.
+
+    Those private columns give a diagonal D = Σ_private B_ij² M⁻¹_j and the k others
+    U = B_O M_O^{-1/2}, so S = D + U Uᵀ and, by Woodbury,
+
+        S⁻¹ r = D⁻¹ r − D⁻¹ U C⁻¹ Uᵀ D⁻¹ r,    C = I_k + Uᵀ D⁻¹ U   (k × k, dense SPD),
+
+    one Cholesky factorisation of C, then per solve two products with U and a dense
+    triangular pair. Rows in their pivot basis (v_F + P v_O = 0: the fine mediator of a
+    nested patch) have this form: on the ball impact's two bands (4,301 rows, k = 480 in two
+    groups) a solve takes 0.15 ms against 0.75 ms for the sparse LU of the rows as assembled.
+    C's eigenvalues are at least 1: S is positive definite whatever B (the private columns
+    make the rows independent).
+
+    Parameters
+    ----------
+    b : sparse, shape (m, n)
+        The rows (on the dofs they touch).
+    inv_mass : ndarray, shape (n,)
+        M⁻¹ on those dofs (1/kg).
+    private : ndarray of bool, shape (n,)
+        The columns touched by one row each (every row must have one).
+    """
+
+    def __init__(self, b: sp.csr_matrix, inv_mass: np.ndarray, private: np.ndarray) -> None:
+        b = sp.csr_matrix(b)
+        bp = b[:, np.nonzero(private)[0]]
+        self.d = np.asarray(bp.multiply(bp) @ inv_mass[private]).ravel()
+        if not np.all(self.d > 0.0):
+            raise ValueError("every row needs a private column with a non-zero entry")
+        others = np.nonzero(~private)[0]
+        self.u = (b[:, others] @ sp.diags(np.sqrt(inv_mass[others]))).tocsr()
+        self.u_t = self.u.T.tocsr()
+        cap = np.eye(others.size) + (self.u_t @ sp.diags(1.0 / self.d) @ self.u).toarray()
+        self.cho = dense_cho_factor(cap) if others.size else None
+        self.shape = (b.shape[0], b.shape[0])
+        self.k = int(others.size)
+
+    def solve(self, rhs: np.ndarray) -> np.ndarray:
+        """Solve S x = rhs; rhs of shape (m,) or (m, c)."""
+        d = self.d if rhs.ndim == 1 else self.d[:, None]
+        y = rhs / d
+        if self.cho is None:
+            return y
+        z = dense_cho_solve(self.cho, self.u_t @ y)
+        return y - (self.u @ z) / d
+
+
+class RowGroupsSolver:
+    """Solves (B M⁻¹ Bᵀ) x = r for rows in groups that share no dof, one solver a group."""
+
+    def __init__(self, groups: list[np.ndarray], solvers: list) -> None:
+        self.groups, self.solvers = groups, solvers
+        m = sum(g.size for g in groups)
+        self.shape = (m, m)
+
+    def solve(self, rhs: np.ndarray) -> np.ndarray:
+        """Solve S x = rhs; rhs of shape (m,) or (m, c)."""
+        x = np.empty_like(rhs, dtype=float)
+        for g, sol in zip(self.groups, self.solvers):
+            x[g] = sol.solve(rhs[g])
+        return x
+
+
+#: Largest capacitance matrix (k × k) of a DiagonalLowRankSolver group.
+_DENSE_CAPACITANCE = 1500
+
+
+def _diagonal_low_rank(b: sp.csr_matrix, pattern: sp.csr_matrix, counts: np.ndarray,
+                       inv_mass: np.ndarray):  # fmt: skip
+    """A DiagonalLowRankSolver (one a group of rows sharing dofs) if every row has a private
+    column and each group's other columns are few; None otherwise."""
+    private = counts == 1
+    if not np.all(pattern @ private.astype(float) > 0):
+        return None
+    m = b.shape[0]
+    graph = sp.bmat([[None, pattern], [pattern.T, None]], format="csr")
+    _, label = connected_components(graph, directed=False)
+    row_label = label[:m]
+    groups = [np.nonzero(row_label == g)[0] for g in np.unique(row_label)]
+    solvers = []
+    for rows in groups:
+        sub = b[rows]
+        cols = np.unique(sub.indices)
+        k = int((~private[cols]).sum())
+        if k > min(_DENSE_CAPACITANCE, rows.size):
+            return None
+        solvers.append(DiagonalLowRankSolver(sub[:, cols], inv_mass[cols], private[cols]))
+    if len(solvers) == 1:
+        return solvers[0]
+    return RowGroupsSolver(groups, solvers)
+
+
 #: Columns shared by more rows than this (and than 4× the median) are candidates for U.
 _HEAVY_COLUMN = 32
 
 
 def factor_rows(
     b: sp.spmatrix, inv_mass: np.ndarray, what: str, names: Callable[[int], str] | None = None
-) -> ScaledLU | LowRankSplitSolver | IsolatedRowsSolver | None:
+) -> Any:
     """Factorisation of the impulse matrix B M⁻¹ Bᵀ of constraint rows (None if no rows).
 
     Rows sharing no dof with another row are split off (:class:`IsolatedRowsSolver`);
+    :class:`DiagonalLowRankSolver` (by groups of rows that share dofs) when every row has a
+    dof of its own and each group has at most 1500 others;
     :class:`LowRankSplitSolver` when a few columns shared by many rows (at most a fifth of the
     rows, each row keeping a column of its own) make the matrix at least 4× denser than
     without them; one :class:`ScaledLU` otherwise, or if the split's A is singular (then the
@@ -315,6 +417,10 @@ def factor_rows(
         sub_names = None if names is None else (lambda i: names(int(rest[i])))
         return IsolatedRowsSolver(isolated, diag, rest,
                                   factor_rows(b[rest], inv_mass, what, sub_names))  # fmt: skip
+    # rows with a dof of their own each (rows in their pivot basis): diagonal plus low rank
+    diag = _diagonal_low_rank(b, pattern, counts, inv_mass)
+    if diag is not None:
+        return diag
     used = counts[counts > 0]
     heavy = counts > max(_HEAVY_COLUMN, 4.0 * (np.median(used) if used.size else 0.0))
     if heavy.any():
