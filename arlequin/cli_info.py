@@ -1,4 +1,4 @@
-"""``arlequin info``: the versions of the stack, off-screen rendering, numba's threads.
+"""``arlequin info``: the versions of the stack, off-screen rendering, numba's and BLAS's threads.
 
 What a bug report needs and what decides whether the demos can draw their pictures here.
 """
@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import importlib.metadata
+import os
 import platform
 
 from .cli_common import write_json
@@ -15,7 +16,7 @@ __all__ = ["add_info", "environment_report"]
 
 #: The distributions reported, in order.
 STACK = ("arlequin", "numpy", "scipy", "scikit-fem", "meshio", "h5py", "trimesh", "pyvista",
-         "vtk", "numba", "matplotlib", "tqdm")  # fmt: skip
+         "vtk", "numba", "threadpoolctl", "matplotlib", "tqdm")  # fmt: skip
 
 
 def _offscreen_rendering() -> str:
@@ -50,6 +51,14 @@ def environment_report(render: bool = True) -> dict:
                    "numba_threading_layer": numba.config.THREADING_LAYER}  # fmt: skip
     except ImportError:  # pragma: no cover (numba is a dependency)
         threads = {"numba_threads": None, "numba_threading_layer": None}
+    threads["omp_wait_policy"] = os.environ.get("OMP_WAIT_POLICY")
+    try:
+        from threadpoolctl import threadpool_info
+
+        threads["blas"] = [f"{p['internal_api']} {p.get('version')}: {p['num_threads']} threads"
+                           for p in threadpool_info() if p["user_api"] == "blas"]  # fmt: skip
+    except ImportError:  # pragma: no cover (threadpoolctl is a dependency)
+        threads["blas"] = []
     report = {"python": platform.python_version(), "platform": platform.platform(),
               "versions": versions, **threads}  # fmt: skip
     if render:
@@ -64,7 +73,10 @@ def _cmd_info(args: argparse.Namespace) -> int:
     for dist, version in report["versions"].items():
         print(f"  {dist:<12} {version or 'not installed'}")
     print(f"numba threads: {report['numba_threads']} "
-          f"(threading layer setting: {report['numba_threading_layer']})")  # fmt: skip
+          f"(threading layer setting: {report['numba_threading_layer']}; OMP_WAIT_POLICY "
+          f"{report['omp_wait_policy']})")  # fmt: skip
+    for blas in report["blas"]:
+        print(f"BLAS: {blas} (one in the explicit time loop)")
     if "offscreen_rendering" in report:
         print(f"off-screen pictures: {report['offscreen_rendering']}")
     return 0

@@ -39,6 +39,8 @@ import resource
 import subprocess
 import sys
 
+import _threads  # before numba runs: OpenMP threads sleep between parallel regions
+
 
 def one_level(n: int, fbar: bool, window: float, geometry: str = "axisymmetric") -> dict:
     from arlequin.demos.taylor_bar import TAYLOR_REFERENCE, run_taylor_bar
@@ -182,7 +184,8 @@ def main(argv: list[str] | None = None) -> int:
         warm_up_solid() if args.geometry == "3d" else warm_up()
         out = compare(args.compare, args.coarse_size, args.coarse_step_ratio, args.geometry,
                       args.patch_length)  # fmt: skip
-        print(json.dumps({"benchmark": "taylor_bar_compare", **out}, indent=2))
+        print(json.dumps({"benchmark": "taylor_bar_compare", **out,
+                          "threads": _threads.settings()}, indent=2))
         return 0
     if args.single is not None:
         print(json.dumps(one_level(args.single, not args.no_fbar, args.window, args.geometry)))
@@ -202,7 +205,8 @@ def main(argv: list[str] | None = None) -> int:
         out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
         records.append(json.loads(out.strip().splitlines()[-1]))
         print(json.dumps(records[-1]), file=sys.stderr, flush=True)
-    print(json.dumps({"benchmark": "taylor_bar", "levels": records}, indent=2))
+    print(json.dumps({"benchmark": "taylor_bar", "levels": records,
+                      "threads": _threads.settings()}, indent=2))
     return 0
 
 

@@ -22,6 +22,7 @@ from skfem import Mesh
 from arlequin.dofs import node_dofs
 from arlequin.geometry import cyclic_quad_faces, facet_normals
 
+from .contact_kernel import project_segments
 from .obstacles import Obstacle
 
 __all__ = [
@@ -268,11 +269,17 @@ class DeformableContactPair(ContactPair):
         Their ``offset`` locate each body in the global dof vector.
     n_dofs : int or DofMap
         Size of the global dof vector (or the system's dof map).
+    compiled : bool
+        Point-to-segment projection by the compiled kernel
+        (:func:`~arlequin.models.contact_kernel.project_segments`, default) or the numpy path
+        (its reference: the same results bit for bit).
     """
 
-    def __init__(self, slave: ContactSurface, master: ContactSurface, n_dofs: Any) -> None:
+    def __init__(self, slave: ContactSurface, master: ContactSurface, n_dofs: Any,
+                 compiled: bool = True) -> None:  # fmt: skip
         if slave.dim != master.dim:
             raise ValueError(f"slave and master dimensions differ: {slave.dim} and {master.dim}")
+        self.compiled = bool(compiled)
         self.slave = slave
         self.master = master
         self.n_dofs = _n_dofs(n_dofs)
@@ -292,6 +299,8 @@ class DeformableContactPair(ContactPair):
         self._r_s = np.repeat(np.arange(m), d)
         self._c_s = slave._dofs.T.ravel()
         self._r_m = np.repeat(np.arange(m), nv * d)
+        self._pattern: tuple | None = None  # the rows' pattern for the last facets (geometry)
+        self._orient_f = np.ascontiguousarray(self._orient, dtype=float)
 
     def _project(self, xs: np.ndarray, u: np.ndarray):
         """Closest master facet of each slave point: (facet, shape values (m, n_v), x_m, normal)."""
@@ -307,14 +316,19 @@ class DeformableContactPair(ContactPair):
             normal = np.repeat(self._orient[k][None, :], 1, axis=0)
             return k, shape, xf[:, k, 0], normal
         if nv == 2:
-            a, b = xf[:, None, :, 0], xf[:, None, :, 1]
-            t = np.sum((xs[:, :, None] - a) * (b - a), axis=0) / np.sum((b - a) ** 2, axis=0)
-            t = np.clip(t, 0.0, 1.0)
-            xp = a + t[None] * (b - a)
-            dist = np.sum((xs[:, :, None] - xp) ** 2, axis=0)
-            k = np.argmin(dist, axis=1)
-            idx = np.arange(xs.shape[1])
-            tk = t[idx, k]
+            if self.compiled:
+                k, tk, nrm, xm = project_segments(
+                    np.ascontiguousarray(xs), np.ascontiguousarray(xf[..., 0]),
+                    np.ascontiguousarray(xf[..., 1]), self._orient_f)  # fmt: skip
+                return k, np.stack([1.0 - tk, tk], axis=1), xm, nrm
+            else:  # the reference of the compiled projection
+                a, b = xf[:, None, :, 0], xf[:, None, :, 1]
+                t = np.sum((xs[:, :, None] - a) * (b - a), axis=0) / np.sum((b - a) ** 2, axis=0)
+                t = np.clip(t, 0.0, 1.0)
+                xp = a + t[None] * (b - a)
+                dist = np.sum((xs[:, :, None] - xp) ** 2, axis=0)
+                k = np.argmin(dist, axis=1)
+                tk = t[np.arange(xs.shape[1]), k]
             shape = np.stack([1.0 - tk, tk], axis=1)
         else:
             bary, dist = _closest_on_triangles(xs, xf)
@@ -334,25 +348,40 @@ class DeformableContactPair(ContactPair):
         nv = shape.shape[1]
         # slave part: −n·v_s; master part: +N_j n·v_j
         v_s = (-n).T  # (m, d)
-        c_m = self._tri_dofs_by_point[k]  # (m, nv, d)
         v_m = shape[:, :, None] * n.T[:, None, :]
-        ij = (np.concatenate([self._r_s, self._r_m]), np.concatenate([self._c_s, c_m.ravel()]))
-        rows = _rows_by_point(np.hstack([v_s, v_m.reshape(m, nv * d)]),
-                              np.hstack([self._c_s.reshape(m, d), c_m.reshape(m, nv * d)]),
-                              self.n_dofs)  # fmt: skip
-        if rows is None:  # a dof twice in a row (a surface against itself): summed by COO
+        pattern = self._pattern
+        if pattern is None or not np.array_equal(pattern[0], k):
+            # the rows' columns depend on the facets the points project on alone (the same
+            # from one step to the next, mostly): their order and arrays made once for them
+            c_m = self._tri_dofs_by_point[k]  # (m, nv, d)
+            ij = (np.concatenate([self._r_s, self._r_m]),
+                  np.concatenate([self._c_s, c_m.ravel()]))  # fmt: skip
+            cols = np.hstack([self._c_s.reshape(m, d), c_m.reshape(m, nv * d)])
+            pattern = (k.copy(), ij, _row_pattern(cols, self.n_dofs))
+            self._pattern = pattern
+        _, ij, by_point = pattern
+        if by_point is None:  # a dof twice in a row (a surface against itself): summed by COO
             vals = np.concatenate([v_s.ravel(), v_m.ravel()])
             rows = sp.csr_matrix((vals, ij), shape=(m, self.n_dofs))
+        else:
+            order, indices, indptr = by_point
+            vals = np.hstack([v_s, v_m.reshape(m, nv * d)])
+            data = np.take_along_axis(vals, order, axis=1).ravel()
+            # copies: a consumer may sort or prune a matrix's arrays in place
+            rows = sp.csr_matrix((data, indices.copy(), indptr.copy()), shape=(m, self.n_dofs))
         return ContactGeometry(rows, gap, n, _JumpRows(ij, (m, self.n_dofs), shape))
 
 
-def _rows_by_point(vals: np.ndarray, cols: np.ndarray, n: int) -> sp.csr_matrix | None:
-    """CSR rows with the entries ``vals`` (m, w) in the columns ``cols`` (m, w), row by row.
+def _row_pattern(cols: np.ndarray, n: int):
+    """CSR arrays of rows with entries in the columns ``cols`` (m, w), row by row: (the order
+    that sorts each row's entries (m, w), indices, indptr), or None if a row has a column
+    twice (the caller sums them by COO).
 
-    The arrays of ``sp.csr_matrix((vals, (rows, cols)))`` (columns sorted in each row, explicit
-    zeros kept) without its COO conversion and duplicate summation (the deformable pair's
-    geometry took 150 µs a step with them, 110 without, at 26 points); None if a row has a
-    column twice (the caller sums them by COO).
+    ``sp.csr_matrix((data, indices, indptr))`` with ``data`` the entries taken in that order
+    is ``sp.csr_matrix((vals, (rows, cols)))`` (columns sorted in each row, explicit zeros
+    kept) without its COO conversion and duplicate summation (the deformable pair's geometry
+    took 150 µs a step with them, 110 without, at 26 points), and the arrays are kept while the
+    points project on the same facets.
     """
     order = np.argsort(cols, axis=1)
     cols = np.take_along_axis(cols, order, axis=1)
@@ -361,8 +390,7 @@ def _rows_by_point(vals: np.ndarray, cols: np.ndarray, n: int) -> sp.csr_matrix 
     m, w = cols.shape
     index_dtype = np.int32 if max(n, m * w) < np.iinfo(np.int32).max else np.int64
     indptr = np.arange(0, m * w + 1, w, dtype=index_dtype)
-    data = np.take_along_axis(vals, order, axis=1).ravel()
-    return sp.csr_matrix((data, cols.ravel().astype(index_dtype), indptr), shape=(m, n))
+    return order, cols.ravel().astype(index_dtype), indptr
 
 
 @dataclass(frozen=True)

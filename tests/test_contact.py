@@ -98,6 +98,30 @@ def test_deformable_pair_gap_and_rows(dim):
     np.testing.assert_allclose(geo.rows @ v, 1.0)
 
 
+def test_compiled_segment_search_is_the_numpy_path():
+    # a curved slave surface above a deformed master: points over segment ends tie between
+    # two segments (the first one is taken by both paths); same segments, parameters, gaps
+    # and rows bit for bit
+    ball = skfem.MeshQuad.init_tensor(np.linspace(0.0, 0.6, 13), np.linspace(0.0, 0.5, 5))
+    x = ball.p.copy()
+    x[1] += 0.02 + 0.1 * x[0] ** 2  # its bottom a parabola 2 cm above the block at the axis
+    ball = skfem.MeshQuad(x, ball.t)
+    block = skfem.MeshQuad.init_tensor(np.linspace(0.0, 0.8, 9), np.linspace(-0.4, 0.0, 3))
+    n = ball.p.size + block.p.size
+    slave = ContactSurface(ball, where=lambda x: x[1] < 0.02 + 0.1 * x[0] ** 2 + 1e-3)
+    master = ContactSurface(block, where=lambda x: x[1] > -1e-9, offset=ball.p.size)
+    fast = DeformableContactPair(slave, master, n)
+    ref = DeformableContactPair(slave, master, n, compiled=False)
+    rng = np.random.default_rng(0)
+    for u in (np.zeros(n), 1e-3 * rng.standard_normal(n)):
+        xs = slave.positions(u)
+        for a, b in zip(fast._project(xs, u), ref._project(xs, u)):
+            np.testing.assert_array_equal(a, b)
+        ga, gb = fast.geometry(u), ref.geometry(u)
+        np.testing.assert_array_equal(ga.gap, gb.gap)
+        assert (ga.rows != gb.rows).nnz == 0
+
+
 def test_point_to_triangle_projection():
     tet = skfem.MeshTet.init_tensor(np.linspace(0, 1, 3), np.linspace(0, 1, 3), np.array([-1, 0.0]))
     master = ContactSurface(tet, where=lambda x: x[2] > -1e-9, offset=0)

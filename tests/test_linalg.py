@@ -129,18 +129,17 @@ def _pivot_basis_rows(n_groups: int, n_rows: int, n_shared: int, seed: int = 0):
     return b, inv_mass
 
 
-@pytest.mark.parametrize("n_groups", [1, 3])
-def test_factor_rows_diagonal_plus_low_rank(n_groups):
-    from arlequin.integrators.linalg import DiagonalLowRankSolver, RowGroupsSolver, factor_rows
+@pytest.mark.parametrize("n_groups,n_shared", [(1, 12), (3, 12), (4, 40)])
+def test_factor_rows_diagonal_plus_low_rank(n_groups, n_shared):
+    from arlequin.integrators.linalg import DiagonalLowRankSolver, factor_rows
 
-    b, inv_mass = _pivot_basis_rows(n_groups, n_rows=60, n_shared=12)
+    b, inv_mass = _pivot_basis_rows(n_groups, n_rows=60, n_shared=n_shared)
     solver = factor_rows(b, inv_mass, "test rows")
-    if n_groups == 1:
-        assert isinstance(solver, DiagonalLowRankSolver) and solver.k == 12
-    else:
-        # one capacitance matrix a group (3 of 12 × 12, not one of 36 × 36)
-        assert isinstance(solver, RowGroupsSolver) and len(solver.solvers) == 3
-        assert all(isinstance(s, DiagonalLowRankSolver) and s.k == 12 for s in solver.solvers)
+    # the shared dofs of more than one row go to U (a random one may have a single row)
+    counts = np.diff(b.tocsc().indptr)
+    assert isinstance(solver, DiagonalLowRankSolver) and solver.k == int((counts > 1).sum())
+    # groups of rows apart make C block diagonal: one factor a group (dense at these sizes)
+    assert len(solver._groups) == n_groups and all(dense for *_, dense in solver._groups)
     s = (b @ sp.diags(inv_mass) @ b.T).toarray()
     rng = np.random.default_rng(4)
     for rhs in (rng.standard_normal(b.shape[0]), rng.standard_normal((b.shape[0], 3))):
@@ -162,3 +161,49 @@ def test_factor_rows_diagonal_path_needs_a_private_dof_in_every_row():
     s = (b @ sp.diags(inv_mass) @ b.T).toarray()
     rhs = np.random.default_rng(5).standard_normal(b.shape[0])
     assert np.allclose(solver.solve(rhs), np.linalg.solve(s, rhs), rtol=1e-11, atol=1e-13)
+
+
+def test_diagonal_low_rank_groups_beyond_the_dense_size_are_sparse():
+    from arlequin.integrators import linalg
+
+    b, inv_mass = _pivot_basis_rows(2, n_rows=800, n_shared=350)
+    solver = linalg.factor_rows(b, inv_mass, "test rows")
+    assert [dense for *_, dense in solver._groups] == [False, False]  # 350 > 300 shared dofs
+    s = (b @ sp.diags(inv_mass) @ b.T).toarray()
+    rhs = np.random.default_rng(6).standard_normal(b.shape[0])
+    assert np.allclose(solver.solve(rhs), np.linalg.solve(s, rhs), rtol=1e-11, atol=1e-13)
+
+
+@pytest.mark.parametrize("touch", ["decoupled", "coupled", "none"])
+def test_impulse_solver_schur_paths_against_the_dense_system(touch):
+    # equality rows in their pivot basis plus single-dof rows, active rows touching the
+    # single-dof rows' dofs (decoupled in S_EE: divisions), a band's dofs (coupled: the
+    # general Schur path) or neither: the impulses of the whole system solved dense
+    from types import SimpleNamespace
+
+    from arlequin.integrators.impulses import ImpulseSolver
+
+    b, inv_mass = _pivot_basis_rows(1, n_rows=50, n_shared=10)
+    n_b = b.shape[1]
+    singles = sp.csr_matrix((np.ones(4), (np.arange(4), n_b + np.arange(4))), shape=(4, n_b + 8))
+    eq = sp.vstack([sp.hstack([b, sp.csr_matrix((50, 8))]), singles]).tocsr()
+    n = eq.shape[1]
+    rng = np.random.default_rng(7)
+    inv_mass = np.concatenate([inv_mass, rng.uniform(0.5, 2.0, 8)])
+    cols = np.unique(eq.indices)
+    rows = SimpleNamespace(m=eq.shape[0], matrix=eq, matrix_cols=eq[:, cols].tocsr(), cols=cols,
+                           row_name=lambda i: f"row {i}")  # fmt: skip
+    solver = ImpulseSolver(rows, inv_mass)
+    own = {"decoupled": [n_b, n_b + 1], "coupled": [0, 60], "none": []}[touch]
+    g = np.zeros((3, n))
+    for i, c in enumerate([n_b + 4, n_b + 5, n_b + 6]):  # dofs of the active rows alone
+        g[i, c] = 1.0
+    for i, c in enumerate(own):
+        g[i, c] = -0.7
+    g_a = sp.csr_matrix(g)
+    full = sp.vstack([eq, g_a]).toarray()
+    s = full @ np.diag(inv_mass) @ full.T
+    r_e, r_a = rng.standard_normal(eq.shape[0]), rng.standard_normal(3)
+    lam_e, lam_a = solver.solve(r_e, g_a, r_a)
+    ref = np.linalg.solve(s, np.concatenate([r_e, r_a]))
+    np.testing.assert_allclose(np.concatenate([lam_e, lam_a]), ref, rtol=1e-11, atol=1e-12)

@@ -124,6 +124,8 @@ class Integrator:
     lumped_default = False
     #: Whether the scheme applies the trials' prescribed multipliers (``applied``, slip friction).
     applies_multipliers = False
+    #: BLAS threads during :func:`~arlequin.integrators.solve`'s loop (None: as they are).
+    blas_threads: int | None = None
 
     def __init__(
         self,
@@ -153,15 +155,12 @@ class Integrator:
                     f"constraint {k} is a {type(c).__name__}: give LinearConstraint rows or "
                     "objects of the UnilateralConstraint protocol (arlequin.contract)"
                 )
-        self.unilateral: list[UnilateralConstraint] = [
-            c for c in all_constraints if is_unilateral(c)
-        ]
+        self.unilateral: list[UnilateralConstraint] = [c for c in all_constraints
+                                                       if is_unilateral(c)]  # fmt: skip
         for c in self.unilateral:
             if getattr(c, "explicit_only", False) and not self.applies_multipliers:
-                raise ValueError(
-                    f"constraint {c.name!r} prescribes multipliers (slip friction): it runs "
-                    f"with the explicit integrator, not {self.name!r}"
-                )
+                raise ValueError(f"constraint {c.name!r} prescribes multipliers (slip friction): "
+                                 f"it runs with the explicit integrator, not {self.name!r}")
         self.rows = self._equality_rows([c for c in all_constraints if not is_unilateral(c)])
         names = [c.name for c in self.unilateral] + list(self.rows.slices)
         if len(set(names)) != len(names):

@@ -22,6 +22,7 @@ from .controllers import FixedStep
 from .recorder import Recorder
 from .registry import get_integrator
 from .result import DynamicResult
+from .threads import blas_threads
 
 logger = logging.getLogger(__name__)
 
@@ -156,6 +157,16 @@ def solve(
         On NaN/overflow or a failed step; ``err.result`` holds what was recorded until then.
     """
     cls = get_integrator(integrator)
+    with blas_threads(cls.blas_threads):
+        return _solve(cls, system, t_end, dt, n_steps, t0, u0, v0, t_eval, step_controller,
+                      callback, record_every, save_fields, on_record, on_step, on_checkpoint,
+                      restore, options)  # fmt: skip
+
+
+def _solve(cls, system, t_end, dt, n_steps, t0, u0, v0, t_eval, step_controller, callback,
+           record_every, save_fields, on_record, on_step, on_checkpoint, restore,
+           options) -> DynamicResult:  # fmt: skip
+    """:func:`solve` with the integrator's class resolved."""
     known = options_of(cls)
     unknown = sorted(set(options) - set(known))
     if unknown:

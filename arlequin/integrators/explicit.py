@@ -93,6 +93,8 @@ class CentralDifference(Integrator):
     name = "explicit"
     lumped_default = True
     applies_multipliers = True
+    # its dense products are a few contact rows: a BLAS pool would spin on the kernels' cores
+    blas_threads = 1
 
     def __init__(
         self,

@@ -26,7 +26,6 @@ __all__ = [
     "DiagonalLowRankSolver",
     "IsolatedRowsSolver",
     "LowRankSplitSolver",
-    "RowGroupsSolver",
     "ScaledLU",
     "dense_cho_factor",
     "dense_cho_solve",
@@ -157,6 +156,13 @@ class ScaledLU:
                 "rows)"
             )
 
+    def decoupled_rows(self) -> tuple[np.ndarray, np.ndarray]:
+        """(the rows coupled to no other: all of a diagonal matrix, none otherwise; their
+        diagonal entries)."""
+        if self._inv_diag is None:
+            return np.zeros(0, dtype=np.int64), np.zeros(0)
+        return np.arange(self.shape[0]), 1.0 / self._inv_diag
+
     def solve(self, rhs: np.ndarray) -> np.ndarray:
         """Solve A x = rhs; rhs of shape (N,) or (N, k)."""
         if self._inv_diag is not None:
@@ -269,6 +275,10 @@ class IsolatedRowsSolver:
         m = isolated.size + rest.size
         self.shape = (m, m)
 
+    def decoupled_rows(self) -> tuple[np.ndarray, np.ndarray]:
+        """(the isolated rows, their diagonal entries)."""
+        return self.isolated, 1.0 / self.inv_diag
+
     def solve(self, rhs: np.ndarray) -> np.ndarray:
         """Solve S x = rhs; rhs of shape (m,) or (m, k)."""
         x = np.zeros_like(rhs, dtype=float)
@@ -286,14 +296,17 @@ class DiagonalLowRankSolver:
     Those private columns give a diagonal D = Σ_private B_ij² M⁻¹_j and the k others
     U = B_O M_O^{-1/2}, so S = D + U Uᵀ and, by Woodbury,
 
-        S⁻¹ r = D⁻¹ r − D⁻¹ U C⁻¹ Uᵀ D⁻¹ r,    C = I_k + Uᵀ D⁻¹ U   (k × k, dense SPD),
+        S⁻¹ r = D⁻¹ r − D⁻¹ U C⁻¹ Uᵀ D⁻¹ r,    C = I_k + Uᵀ D⁻¹ U   (k × k, SPD),
 
-    one Cholesky factorisation of C, then per solve two products with U and a dense
-    triangular pair. Rows in their pivot basis (v_F + P v_O = 0: the fine mediator of a
-    nested patch) have this form: on the ball impact's two bands (4,301 rows, k = 480 in two
-    groups) a solve takes 0.15 ms against 0.75 ms for the sparse LU of the rows as assembled.
-    C's eigenvalues are at least 1: S is positive definite whatever B (the private columns
-    make the rows independent).
+    one factorisation of C (by its independent groups: C couples the shared dofs that share a
+    row, a coarse mesh's neighbours; dense groups up to 300 dofs, SuperLU beyond), then per
+    solve two products with U and C's triangular solves. Rows in their pivot basis
+    (v_F + P v_O = 0: the fine mediator of a nested patch,
+    :mod:`arlequin.integrators.row_basis`) and single-dof rows have this form: on the ball
+    impact's equality rows (two bands and the axes, 4,592 rows, k = 450 in four groups) a
+    solve takes 0.06 ms against 0.75 ms for the sparse LU of the rows as assembled. C's
+    eigenvalues are at least 1: S is positive definite whatever B (the private columns make
+    the rows independent).
 
     Parameters
     ----------
@@ -312,67 +325,66 @@ class DiagonalLowRankSolver:
         if not np.all(self.d > 0.0):
             raise ValueError("every row needs a private column with a non-zero entry")
         others = np.nonzero(~private)[0]
+        k = int(others.size)
         self.u = (b[:, others] @ sp.diags(np.sqrt(inv_mass[others]))).tocsr()
         self.u_t = self.u.T.tocsr()
-        cap = np.eye(others.size) + (self.u_t @ sp.diags(1.0 / self.d) @ self.u).toarray()
-        self.cho = dense_cho_factor(cap) if others.size else None
+        cap = (sp.identity(k) + self.u_t @ sp.diags(1.0 / self.d) @ self.u).tocsr()
+        # C couples the shared dofs that share a row (a coarse mesh's neighbours), in groups
+        # apart (a band, a displacement component): each group's factor, dense when small
+        # (LAPACK's solve of 110 unknowns takes 7 µs, SuperLU's wrapper about as much alone)
+        self._groups: list[tuple[np.ndarray, Any, bool]] = []
+        if k:
+            _, label = connected_components(cap, directed=False)
+            for g in np.unique(label):
+                idx = np.nonzero(label == g)[0]
+                block = cap[idx][:, idx]
+                if idx.size <= _DENSE_GROUP:
+                    self._groups.append((idx, dense_cho_factor(block.toarray()), True))
+                else:
+                    lu = spla.splu(block.tocsc(), permc_spec="MMD_AT_PLUS_A",
+                                   diag_pivot_thresh=0.0)  # fmt: skip
+                    self._groups.append((idx, lu, False))
         self.shape = (b.shape[0], b.shape[0])
-        self.k = int(others.size)
+        self.k = k
+
+    def decoupled_rows(self) -> tuple[np.ndarray, np.ndarray]:
+        """(the rows coupled to no other in S: no shared column, their diagonal entries)."""
+        free = np.nonzero(np.diff(self.u.indptr) == 0)[0]
+        return free, self.d[free]
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
         """Solve S x = rhs; rhs of shape (m,) or (m, c)."""
         d = self.d if rhs.ndim == 1 else self.d[:, None]
         y = rhs / d
-        if self.cho is None:
+        if self.k == 0:
             return y
-        z = dense_cho_solve(self.cho, self.u_t @ y)
+        w = self.u_t @ y
+        if len(self._groups) == 1:
+            _, fac, dense = self._groups[0]
+            z = dense_cho_solve(fac, w) if dense else fac.solve(w)
+        else:
+            z = np.empty_like(w)
+            for idx, fac, dense in self._groups:
+                z[idx] = dense_cho_solve(fac, w[idx]) if dense else fac.solve(w[idx])
         return y - (self.u @ z) / d
 
 
-class RowGroupsSolver:
-    """Solves (B M⁻¹ Bᵀ) x = r for rows in groups that share no dof, one solver a group."""
-
-    def __init__(self, groups: list[np.ndarray], solvers: list) -> None:
-        self.groups, self.solvers = groups, solvers
-        m = sum(g.size for g in groups)
-        self.shape = (m, m)
-
-    def solve(self, rhs: np.ndarray) -> np.ndarray:
-        """Solve S x = rhs; rhs of shape (m,) or (m, c)."""
-        x = np.empty_like(rhs, dtype=float)
-        for g, sol in zip(self.groups, self.solvers):
-            x[g] = sol.solve(rhs[g])
-        return x
-
-
-#: Largest capacitance matrix (k × k) of a DiagonalLowRankSolver group.
-_DENSE_CAPACITANCE = 1500
-
-
 def _diagonal_low_rank(b: sp.csr_matrix, pattern: sp.csr_matrix, counts: np.ndarray,
-                       inv_mass: np.ndarray):  # fmt: skip
-    """A DiagonalLowRankSolver (one a group of rows sharing dofs) if every row has a private
-    column and each group's other columns are few; None otherwise."""
+                       inv_mass: np.ndarray) -> DiagonalLowRankSolver | None:  # fmt: skip
+    """A DiagonalLowRankSolver if every row has a private column and the others are at most
+    as many as the rows; None otherwise."""
     private = counts == 1
     if not np.all(pattern @ private.astype(float) > 0):
         return None
-    m = b.shape[0]
-    graph = sp.bmat([[None, pattern], [pattern.T, None]], format="csr")
-    _, label = connected_components(graph, directed=False)
-    row_label = label[:m]
-    groups = [np.nonzero(row_label == g)[0] for g in np.unique(row_label)]
-    solvers = []
-    for rows in groups:
-        sub = b[rows]
-        cols = np.unique(sub.indices)
-        k = int((~private[cols]).sum())
-        if k > min(_DENSE_CAPACITANCE, rows.size):
-            return None
-        solvers.append(DiagonalLowRankSolver(sub[:, cols], inv_mass[cols], private[cols]))
-    if len(solvers) == 1:
-        return solvers[0]
-    return RowGroupsSolver(groups, solvers)
+    used = counts > 0
+    if int((used & ~private).sum()) > b.shape[0]:
+        return None
+    cols = np.nonzero(used)[0]
+    return DiagonalLowRankSolver(b[:, cols], inv_mass[cols], private[cols])
 
+
+#: Groups of a DiagonalLowRankSolver's capacitance matrix up to this size are factorised dense.
+_DENSE_GROUP = 300
 
 #: Columns shared by more rows than this (and than 4× the median) are candidates for U.
 _HEAVY_COLUMN = 32
@@ -384,8 +396,8 @@ def factor_rows(
     """Factorisation of the impulse matrix B M⁻¹ Bᵀ of constraint rows (None if no rows).
 
     Rows sharing no dof with another row are split off (:class:`IsolatedRowsSolver`);
-    :class:`DiagonalLowRankSolver` (by groups of rows that share dofs) when every row has a
-    dof of its own and each group has at most 1500 others;
+    :class:`DiagonalLowRankSolver` when every row has a dof of its own and the other dofs are
+    at most as many as the rows;
     :class:`LowRankSplitSolver` when a few columns shared by many rows (at most a fifth of the
     rows, each row keeping a column of its own) make the matrix at least 4× denser than
     without them; one :class:`ScaledLU` otherwise, or if the split's A is singular (then the
@@ -408,6 +420,11 @@ def factor_rows(
     pattern = b.copy()
     pattern.data = np.ones_like(pattern.data)
     counts = np.asarray(pattern.sum(axis=0)).ravel()
+    # rows with a dof of their own each (rows in their pivot basis, single-dof rows):
+    # diagonal plus low rank, the isolated rows with them (no split to gather and scatter)
+    diag = _diagonal_low_rank(b, pattern, counts, inv_mass)
+    if diag is not None:
+        return diag
     # rows whose dofs no other row touches: diagonal (a non-empty row only)
     shared = pattern @ (counts > 1).astype(float)
     isolated = np.nonzero((shared == 0) & (np.diff(b.indptr) > 0))[0]
@@ -417,10 +434,6 @@ def factor_rows(
         sub_names = None if names is None else (lambda i: names(int(rest[i])))
         return IsolatedRowsSolver(isolated, diag, rest,
                                   factor_rows(b[rest], inv_mass, what, sub_names))  # fmt: skip
-    # rows with a dof of their own each (rows in their pivot basis): diagonal plus low rank
-    diag = _diagonal_low_rank(b, pattern, counts, inv_mass)
-    if diag is not None:
-        return diag
     used = counts[counts > 0]
     heavy = counts > max(_HEAVY_COLUMN, 4.0 * (np.median(used) if used.size else 0.0))
     if heavy.any():

@@ -288,10 +288,19 @@ class EqualityRows:
             # Bᵀ of the coupling rows and of the others, apart (made on first use)
             kinds = (np.nonzero(self.coupling)[0], np.nonzero(~self.coupling)[0])
             self._by_kind = [(r, self.matrix_cols[r].T.tocsr()) for r in kinds]
+            # the touched dofs are sorted and every block's dofs contiguous: per-block sums by
+            # reduceat over the blocks present (bincount with weights took 0.1 ms a step)
+            present, starts = np.unique(self.block_of_col, return_index=True)
+            self._block_sums = (present, starts)
         f_c, f_o = (bt @ lam[r] for r, bt in self._by_kind)
-        boc = self.block_of_col
-        return [(-np.bincount(boc, f_c * x, minlength=nb), -np.bincount(boc, f_o * x, minlength=nb))
-                for x in xs]  # fmt: skip
+        present, starts = self._block_sums
+        out = []
+        for x in xs:
+            pc, po = np.zeros(nb), np.zeros(nb)
+            pc[present] = -np.add.reduceat(f_c * x, starts)
+            po[present] = -np.add.reduceat(f_o * x, starts)
+            out.append((pc, po))
+        return out
 
     def row_name(self, i: int) -> str:
         """Description of stacked row ``i`` for error messages."""
