@@ -14,12 +14,14 @@ Arlequin bar (defaults: patch 0.9 L, fine mediator, H1, ramp), the uniform singl
 patch's resolution (``--model mono --mesh-size R/N``) and the graded single mesh (``--model
 graded``), and prints their wall times, the ratios T_arlequin / T_uniform against the bound
 (1 + p)/2 with p the patch's share of the fine cells and T_arlequin / T_graded against 1.3, the
-three quantities of interest of each and the process's peak memory after each run.
+three quantities of interest of each and the process's peak memory after each run. With
+``--repeat N`` the models run N times in rounds and each one's shortest run is its time (all
+of them in ``wall_times_s``).
 
     python benchmarks/taylor_bar.py [--levels 5 10 20 30] [--plain 10 20] [--window 1e-6]
     python benchmarks/taylor_bar.py --compare 20 [--coarse-step-ratio 4]
     python benchmarks/taylor_bar.py --geometry 3d --levels 4 6 8 --plain
-    python benchmarks/taylor_bar.py --geometry 3d --compare 8 [--patch-length LP]
+    python benchmarks/taylor_bar.py --geometry 3d --compare 8 [--patch-length LP] [--repeat N]
 
 ``--geometry 3d``: the quarter bar of hexahedra. There the uniform reference of ``--compare`` is
 the single mesh with the patch's nodes (``--model mono --coarse-size``: the coarse O-grid
@@ -95,7 +97,8 @@ def _qoi(r) -> dict:
 
 
 def compare(n: int, coarse_size: float | None = None, ratio_mts: int = 1,
-            geometry: str = "axisymmetric", patch_length: float | None = None) -> dict:  # fmt: skip
+            geometry: str = "axisymmetric", patch_length: float | None = None,
+            repeat: int = 1) -> dict:  # fmt: skip
     """Arlequin against the uniform fine mesh, in this process (see the module docstring)."""
     import warnings
 
@@ -103,19 +106,28 @@ def compare(n: int, coarse_size: float | None = None, ratio_mts: int = 1,
 
     three_d = geometry == "3d"
     common = dict(elements_radial=n, geometry=geometry)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", GluingBandPlasticityWarning)
-        arl = run_taylor_bar(model="arlequin", coarse_size=coarse_size,
-                             patch_length=patch_length, **common)  # fmt: skip
-    mts = None
-    if ratio_mts > 1:
-        mts = run_taylor_bar(model="arlequin", coarse_size=coarse_size, patch_length=patch_length,
-                             coarse_step_ratio=ratio_mts, **common)  # fmt: skip
-    # 3D: the single mesh with the patch's nodes (the coarse O-grid refined)
-    uni = run_taylor_bar(model="mono", coarse_size=arl.arlequin["coarse_size"] if three_d
-                         else None, **common)  # fmt: skip
-    graded = run_taylor_bar(model="graded", coarse_size=coarse_size, patch_length=patch_length,
-                            **common)  # fmt: skip
+    runs: dict[str, list] = {"arlequin": [], "mts": [], "uniform": [], "graded": []}
+    caught: list = []
+    for _ in range(repeat):  # rounds of every model, so that drifts hit them alike
+        with warnings.catch_warnings(record=True) as seen:
+            warnings.simplefilter("always", GluingBandPlasticityWarning)
+            arl = run_taylor_bar(model="arlequin", coarse_size=coarse_size,
+                                 patch_length=patch_length, **common)  # fmt: skip
+        caught += seen
+        runs["arlequin"].append(arl)
+        if ratio_mts > 1:
+            runs["mts"].append(run_taylor_bar(
+                model="arlequin", coarse_size=coarse_size, patch_length=patch_length,
+                coarse_step_ratio=ratio_mts, **common))  # fmt: skip
+        # 3D: the single mesh with the patch's nodes (the coarse O-grid refined)
+        runs["uniform"].append(run_taylor_bar(
+            model="mono", coarse_size=arl.arlequin["coarse_size"] if three_d else None,
+            **common))  # fmt: skip
+        runs["graded"].append(run_taylor_bar(model="graded", coarse_size=coarse_size,
+                                             patch_length=patch_length, **common))  # fmt: skip
+    # each model's shortest run (the machine's noise only adds), all of them listed
+    fastest = {k: min(v, key=lambda r: r.wall_time_s) if v else None for k, v in runs.items()}
+    arl, mts, uni, graded = (fastest[k] for k in ("arlequin", "mts", "uniform", "graded"))
     a = arl.arlequin
     p = a["patch_fraction"]
     ratio = arl.wall_time_s / uni.wall_time_s
@@ -144,6 +156,9 @@ def compare(n: int, coarse_size: float | None = None, ratio_mts: int = 1,
             "graded_radius_difference": round(graded.mushroom_radius / uni.mushroom_radius - 1,
                                               5),
         })  # fmt: skip
+    for key, name in (("arlequin", "arlequin"), ("uniform", "uniform"), ("graded", "graded")):
+        if out.get(name) is not None:
+            out[name]["wall_times_s"] = [round(r.wall_time_s, 2) for r in runs[key]]
     if mts is not None:
         m = mts.arlequin
         out["multi_time_step"] = {
@@ -174,6 +189,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--geometry", choices=["axisymmetric", "3d"], default="axisymmetric")
     parser.add_argument("--patch-length", type=float, default=None,
                         help="with --compare: the Arlequin patch length (m)")  # fmt: skip
+    parser.add_argument("--repeat", type=int, default=1,
+                        help="with --compare: rounds of every model; each model's shortest run "
+                             "is its time")  # fmt: skip
     parser.add_argument("--single", type=int, default=None, help=argparse.SUPPRESS)
     parser.add_argument("--no-fbar", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
@@ -182,8 +200,10 @@ def main(argv: list[str] | None = None) -> int:
         from arlequin.models.j2_kernel_3d import warm_up_solid
 
         warm_up_solid() if args.geometry == "3d" else warm_up()
+        if args.repeat < 1:
+            parser.error(f"--repeat must be at least 1, got {args.repeat}")
         out = compare(args.compare, args.coarse_size, args.coarse_step_ratio, args.geometry,
-                      args.patch_length)  # fmt: skip
+                      args.patch_length, args.repeat)  # fmt: skip
         print(json.dumps({"benchmark": "taylor_bar_compare", **out,
                           "threads": _threads.settings()}, indent=2))
         return 0
