@@ -20,7 +20,7 @@ import math
 import numba as nb
 import numpy as np
 
-from .j2_kernel import SQRT23, _flow, _plastic_multiplier
+from .j2_kernel import SQRT23, _flow, _plastic_multiplier, read_only
 
 __all__ = ["solid_j2_kernel", "solid_scratch", "warm_up_solid"]
 
@@ -314,8 +314,11 @@ def warm_up_solid() -> None:
     out = [np.zeros((3, nen, ne)), np.zeros((3, 3, ne, nq)), np.zeros((ne, nq)),
            np.zeros((3, 3, ne, nq)), np.zeros((ne, nq)), np.zeros((ne, nq)), np.zeros((ne, nq)),
            np.zeros(ne, dtype=np.int64)]  # fmt: skip
-    solid_j2_kernel(
-        np.zeros(3 * nen), dofs, grad, ones, ones, True, 1.0, 1.0, 0,
-        np.array([1.0, 0.0, 0.0, 0.0, 0.0, 0.0]), 0.0, cp, zeros, zeros, zeros, ones,
-        np.zeros(4), np.ones(ne), *solid_scratch(nq, nen), *out,
-    )  # fmt: skip
+    # the weight as it arrives: a fresh array (a scalar broadcast) or a block term's read-only
+    # array, two types to numba; both compiled here so that no run compiles inside its clock
+    for weight in (ones, read_only(ones)):
+        solid_j2_kernel(
+            np.zeros(3 * nen), dofs, grad, ones, weight, True, 1.0, 1.0, 0,
+            np.array([1.0, 0.0, 0.0, 0.0, 0.0, 0.0]), 0.0, cp, zeros, zeros, zeros, ones,
+            np.zeros(4), np.ones(ne), *solid_scratch(nq, nen), *out,
+        )  # fmt: skip
