@@ -337,6 +337,8 @@ class FiniteStrainJ2:
         u = self._checked_displacement(u)
         out = self._kernel_outputs(2)
         c = np.ascontiguousarray
+        # the weight goes in as a read-only broadcast view whatever its source: one type to
+        # numba, the one warm_up compiles
         planar_j2_kernel(
             u, dofs, grad, val, radius, dv0, c(np.broadcast_to(alpha, (ne, nq)), dtype=float),
             self.kind == "axisymmetric", self.fbar, self.material.bulk_modulus,
@@ -364,6 +366,7 @@ class FiniteStrainJ2:
         dofs, grad, dv0, visc, h0, s_h, s_g, s_m = self._kernel_static
         u = self._checked_displacement(u)
         out = self._kernel_outputs(3)
+        # the weight as a read-only broadcast view, the type warm_up_solid compiles
         solid_j2_kernel(
             u, dofs, grad, dv0, c(np.broadcast_to(alpha, (ne, nq)), dtype=float), self.fbar,
             self.material.bulk_modulus, self.material.shear_modulus, int(law.kernel_code),

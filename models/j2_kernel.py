@@ -415,18 +415,12 @@ def warm_up() -> None:
     out = [np.zeros((2, nen, ne)), np.zeros((3, 3, ne, nq)), np.zeros((ne, nq)),
            np.zeros((3, 3, ne, nq)), np.zeros((ne, nq)), np.zeros((ne, nq)), np.zeros((ne, nq)),
            np.zeros(ne, dtype=np.int64)]  # fmt: skip
-    # the weight as it arrives: a fresh array (a scalar broadcast) or a block term's read-only
-    # array, two types to numba; both compiled here so that no run compiles inside its clock
-    for weight in (ones, read_only(ones)):
-        planar_j2_kernel(
-            np.zeros(2 * nen), dofs, grad, np.full((ne, nq, nen), 0.25), ones, ones, weight,
-            True, True, 1.0, 1.0, 0, np.array([1.0, 0.0, 0.0, 0.0, 0.0, 0.0]), 0.0, cp, zeros,
-            zeros, zeros, ones, np.zeros(4), np.ones(ne), *scratch(nq, nen), *out,
-        )  # fmt: skip
-
-
-def read_only(a: np.ndarray) -> np.ndarray:
-    """A read-only copy of ``a`` (numba types it apart from a writeable array)."""
-    a = a.copy()
-    a.flags.writeable = False
-    return a
+    # the weight as FiniteStrainJ2 passes it, a read-only broadcast view: numba types it
+    # apart from a writeable array, and a writeable one here left each process's first run
+    # compiling (or loading) its own specialisation inside its clock
+    weight = np.broadcast_to(ones, ones.shape)
+    planar_j2_kernel(
+        np.zeros(2 * nen), dofs, grad, np.full((ne, nq, nen), 0.25), ones, ones, weight,
+        True, True, 1.0, 1.0, 0, np.array([1.0, 0.0, 0.0, 0.0, 0.0, 0.0]), 0.0, cp, zeros,
+        zeros, zeros, ones, np.zeros(4), np.ones(ne), *scratch(nq, nen), *out,
+    )  # fmt: skip

@@ -20,7 +20,7 @@ import math
 import numba as nb
 import numpy as np
 
-from .j2_kernel import SQRT23, _flow, _plastic_multiplier, read_only
+from .j2_kernel import SQRT23, _flow, _plastic_multiplier
 
 __all__ = ["solid_j2_kernel", "solid_scratch", "warm_up_solid"]
 
@@ -314,11 +314,12 @@ def warm_up_solid() -> None:
     out = [np.zeros((3, nen, ne)), np.zeros((3, 3, ne, nq)), np.zeros((ne, nq)),
            np.zeros((3, 3, ne, nq)), np.zeros((ne, nq)), np.zeros((ne, nq)), np.zeros((ne, nq)),
            np.zeros(ne, dtype=np.int64)]  # fmt: skip
-    # the weight as it arrives: a fresh array (a scalar broadcast) or a block term's read-only
-    # array, two types to numba; both compiled here so that no run compiles inside its clock
-    for weight in (ones, read_only(ones)):
-        solid_j2_kernel(
-            np.zeros(3 * nen), dofs, grad, ones, weight, True, 1.0, 1.0, 0,
-            np.array([1.0, 0.0, 0.0, 0.0, 0.0, 0.0]), 0.0, cp, zeros, zeros, zeros, ones,
-            np.zeros(4), np.ones(ne), *solid_scratch(nq, nen), *out,
-        )  # fmt: skip
+    # the weight as FiniteStrainJ2 passes it, a read-only broadcast view: numba types it
+    # apart from a writeable array, and a writeable one here left each process's first run
+    # compiling (or loading) its own specialisation inside its clock
+    weight = np.broadcast_to(ones, ones.shape)
+    solid_j2_kernel(
+        np.zeros(3 * nen), dofs, grad, ones, weight, True, 1.0, 1.0, 0,
+        np.array([1.0, 0.0, 0.0, 0.0, 0.0, 0.0]), 0.0, cp, zeros, zeros, zeros, ones,
+        np.zeros(4), np.ones(ne), *solid_scratch(nq, nen), *out,
+    )  # fmt: skip

@@ -189,8 +189,8 @@ def test_return_map_failure_is_a_state_error():
 )
 def test_warm_up_compiles_every_signature_the_taylor_bar_uses(geometry, model, n):
     # the demos' wall clocks start after warm_up: a signature compiled (or loaded) inside the
-    # clock cost the 3D Arlequin bar 21 s of its 237 s with a cold cache (its block term's
-    # weight is read-only, another type to numba than the warm-up's)
+    # clock cost the 3D Arlequin bar 21 s of its 237 s with a cold cache (FiniteStrainJ2 passes
+    # the weight as a read-only view, which the warm-up once passed writeable: another type)
     from arlequin.demos.taylor_bar import run_taylor_bar
     from arlequin.models.j2_kernel import planar_j2_kernel, warm_up
     from arlequin.models.j2_kernel_3d import solid_j2_kernel, warm_up_solid
