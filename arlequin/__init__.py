@@ -7,14 +7,14 @@ mediators (L2 or H1 coupling) on a gluing zone. Physics models live in :mod:`arl
 Public API (``docs/api.md`` lists every name with the module it lives in)
 --------------------------------------------------------------------------
 ArlequinProblem, Patch,
-PatchCoupling                   set up a coupled problem (:mod:`arlequin.problem`,
-                                :mod:`arlequin.gluing`)
+PatchCoupling                   set up a coupled problem (:mod:`arlequin.problem.arlequin_problem`,
+                                :mod:`arlequin.coupling.gluing`)
 MultiBodyProblem                several bodies (problems or models) in one system
-                                (:mod:`arlequin.bodies`)
-refine_region                   nested patches from coarse cells (:mod:`arlequin.patches`)
+                                (:mod:`arlequin.problem.bodies`)
+refine_region                   nested patches from coarse cells (:mod:`arlequin.coupling.patches`)
 RampWeights, ConstantWeights,
-CallableWeights                 partition weights (:mod:`arlequin.weights`)
-solve_static, solve             static and dynamic solves (:mod:`arlequin.integrators`)
+CallableWeights                 partition weights (:mod:`arlequin.coupling.weights`)
+solve_static, solve             static and dynamic solves (:mod:`arlequin.solvers`)
 DofMap                          the dof layout of a coupled system (:mod:`arlequin.dofs`)
 ResultsFolder                   results on disk (:mod:`arlequin.io`)
 evaluate_field, locate_points   fields at points, bounded point locator
@@ -51,7 +51,6 @@ def _map_models_folder() -> None:
 
 _map_models_folder()
 
-from .bodies import MultiBodyProblem
 from .contract import (
     CapabilityError,
     ConstraintError,
@@ -59,19 +58,20 @@ from .contract import (
     SimulationError,
     StateError,
 )
-from .coupling import MediatorError
+from .coupling.fields import evaluate_field
+from .coupling.gluing import ExactnessWarning, Patch, PatchCoupling
+from .coupling.mediators import MediatorError
+from .coupling.overlap import Overlap, OverlapError, build_overlap
+from .coupling.patches import refine_region
+from .coupling.weights import CallableWeights, ConstantWeights, RampWeights, WeightSumError
 from .dofs import DofMap
-from .fields import evaluate_field
-from .gluing import ExactnessWarning, Patch, PatchCoupling
-from .integrators import DynamicResult, solve
-from .integrators.static import SingularSystemError, StaticResult, solve_static
+from .geometry.locate import locate_points
+from .geometry.meshcheck import MeshError, check_mesh
 from .io import ResultsFolder
-from .locate import locate_points
-from .meshcheck import MeshError, check_mesh
-from .overlap import Overlap, OverlapError, build_overlap
-from .patches import refine_region
-from .problem import ArlequinProblem
-from .weights import CallableWeights, ConstantWeights, RampWeights, WeightSumError
+from .problem.arlequin_problem import ArlequinProblem
+from .problem.bodies import MultiBodyProblem
+from .solvers import DynamicResult, solve
+from .solvers.static import SingularSystemError, StaticResult, solve_static
 
 __version__ = "0.1.0"
 

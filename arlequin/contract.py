@@ -1,14 +1,14 @@
 """The contract between the coupling core and the physics models: protocols and shared errors.
 
 This is the only part of :mod:`arlequin` that the models (:mod:`arlequin.models`) import, besides
-the pure helpers listed in ``docs/architecture.md`` (reference elements, facet geometry, the dof
-layout). Everything the core calls on a model or a constraint is written down here, so that a
-new model or constraint is written against this page and nothing else.
+the pure geometry helpers listed in ``docs/architecture.md`` (reference elements, facet
+geometry, mesh checks). Everything the core calls on a model or a constraint is written down here,
+so that a new model or constraint is written against this page and nothing else.
 
 Models
 ------
 A model is single-mesh physics that knows nothing about Arlequin. The integrators need
-:class:`DynamicModel`; an :class:`~arlequin.problem.ArlequinProblem` needs the full
+:class:`DynamicModel`; an :class:`~arlequin.problem.arlequin_problem.ArlequinProblem` needs the full
 :class:`Model` (mesh, bases and loads as well). Every assembled quantity takes an optional
 quadrature-point ``weight`` (the partition weight α of the coupling, default 1), evaluated at the
 quadrature points of the model's basis: an array of shape ``(n_elems, n_qp)``, a scalar, or a
@@ -23,7 +23,7 @@ Optional capabilities are declared by implementing their protocol (checked with
     ``newton="initial"``, a modified Newton iteration on the model's ``stiffness``).
 ``"critical_time_step"`` (:class:`SupportsCriticalTimeStep`)
     an element estimate of the explicit stable step in the current configuration, used by the
-    :class:`~arlequin.integrators.CriticalFraction` controller to follow a changing
+    :class:`~arlequin.solvers.CriticalFraction` controller to follow a changing
     configuration.
 
 State at quadrature points is an immutable object returned by ``internal_force`` as a *trial*
@@ -32,15 +32,21 @@ it, so that a step can be redone from the committed state.
 
 Constraints
 -----------
-Equality rows ``B u = g(t)`` are :class:`arlequin.system.LinearConstraint` records. Rows whose
-active set is decided inside each time step (contact) follow :class:`UnilateralConstraint`: the
-constraint object holds only its configuration; its state lives in immutable records
+Equality rows ``B u = g(t)`` are :class:`arlequin.problem.system.LinearConstraint` records. Rows
+whose active set is decided inside each time step (contact) follow :class:`UnilateralConstraint`:
+the constraint object holds only its configuration; its state lives in immutable records
 (:class:`ConstraintState` between steps, :class:`ConstraintTrial` during a step's status
 iterations) that the integrator passes in and commits. See the protocol for the calling sequence.
 
 Sign convention (every constraint): the force a constraint exerts on the system is ``−Bᵀλ`` (N)
 with ``λ`` the multiplier reported by the integrators, as in the static saddle point
 ``K u + Bᵀλ = f``.
+
+Dof layout
+----------
+Within a model, dofs are interleaved by node (scikit-fem's ``ElementVector`` ordering),
+``local dof = n_components * node + component`` (:func:`node_dofs`); a coupled system stacks
+the models' dof vectors in blocks (:class:`arlequin.dofs.DofMap`).
 
 Units are SI throughout (m, kg, s, Pa, N, J).
 """
@@ -69,6 +75,7 @@ __all__ = [
     "check_protocol",
     "is_linear",
     "is_unilateral",
+    "node_dofs",
     "require",
 ]
 
@@ -94,7 +101,7 @@ class SimulationError(ValueError):
     time : float
         Time (s) the failed step was to reach.
     result : DynamicResult or None
-        What was recorded until then (set by :func:`arlequin.integrators.solve`).
+        What was recorded until then (set by :func:`arlequin.solvers.solve`).
     """
 
     def __init__(self, message: str, step: int, time: float) -> None:
@@ -157,7 +164,7 @@ class DynamicModel(Protocol):
 
 @runtime_checkable
 class Model(DynamicModel, Protocol):
-    """What an :class:`~arlequin.problem.ArlequinProblem` calls on a model.
+    """What an :class:`~arlequin.problem.arlequin_problem.ArlequinProblem` calls on a model.
 
     Attributes
     ----------
@@ -418,3 +425,24 @@ class UnilateralConstraint(Protocol):
 def is_unilateral(constraint: Any) -> bool:
     """Whether a constraint object follows the :class:`UnilateralConstraint` protocol."""
     return isinstance(constraint, UnilateralConstraint)
+
+
+def node_dofs(nodes: np.ndarray, n_components: int, components=None, offset: int = 0) -> np.ndarray:
+    """Dofs of nodes in the interleaved layout, shape (n_components', len(nodes)).
+
+    Parameters
+    ----------
+    nodes : array_like of int
+        Node indices of one model.
+    n_components : int
+        Displacement components per node.
+    components : sequence of int, optional
+        Components to return (default all), each in ``[0, n_components)``.
+    offset : int
+        Added to every dof (the model's block offset in a global vector).
+    """
+    nodes = np.asarray(nodes, dtype=np.int64).ravel()
+    comps = np.arange(n_components) if components is None else np.asarray(components, np.int64)
+    if comps.size and (comps.min() < 0 or comps.max() >= n_components):
+        raise ValueError(f"components must lie in [0, {n_components}), got {comps.tolist()}")
+    return offset + n_components * nodes[None, :] + comps[:, None]

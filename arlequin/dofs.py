@@ -7,7 +7,8 @@ Within a model, dofs are interleaved by node (scikit-fem's ``ElementVector`` ord
 A coupled system stacks the models' dof vectors in blocks, in order; a :class:`DofMap` holds the
 blocks (name, offset, size, components) and converts between nodes, local dofs and global dofs.
 Overlap transfers, coupling matrices, Dirichlet rows, contact rows and the demos all go through
-it. It is a pure helper (no Arlequin concepts), so models may import it.
+it. Its numbering convention, :func:`node_dofs`, is part of the model contract
+(:mod:`arlequin.contract`), where the models import it from.
 """
 
 from __future__ import annotations
@@ -18,28 +19,9 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from .contract import node_dofs
+
 __all__ = ["DofBlock", "DofMap", "node_dofs", "vector_operator"]
-
-
-def node_dofs(nodes: np.ndarray, n_components: int, components=None, offset: int = 0) -> np.ndarray:
-    """Dofs of nodes in the interleaved layout, shape (n_components', len(nodes)).
-
-    Parameters
-    ----------
-    nodes : array_like of int
-        Node indices of one model.
-    n_components : int
-        Displacement components per node.
-    components : sequence of int, optional
-        Components to return (default all), each in ``[0, n_components)``.
-    offset : int
-        Added to every dof (the model's block offset in a global vector).
-    """
-    nodes = np.asarray(nodes, dtype=np.int64).ravel()
-    comps = np.arange(n_components) if components is None else np.asarray(components, np.int64)
-    if comps.size and (comps.min() < 0 or comps.max() >= n_components):
-        raise ValueError(f"components must lie in [0, {n_components}), got {comps.tolist()}")
-    return offset + n_components * nodes[None, :] + comps[:, None]
 
 
 def vector_operator(scalar: sp.spmatrix, n_components: int) -> sp.csr_matrix:

@@ -44,8 +44,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--block-size", type=float, default=0.02, help="R_B = H_B (m)")
     parser.add_argument("--models", default="arlequin,arlequin-1,mono,mono-zoned,graded")
     parser.add_argument("--rigid-wall", action="store_true")
-    parser.add_argument("--coarse-step-ratio", type=int, default=None,
-                        help="arlequin's multi-time-step ratio (default: the demo's, 2)")
+    parser.add_argument(
+        "--coarse-step-ratio",
+        type=int,
+        default=None,
+        help="arlequin's multi-time-step ratio (default: the demo's, 2)",
+    )
     parser.add_argument("--coarse-size", type=float, default=None)
     parser.add_argument("--fine-size", type=float, default=None)
     parser.add_argument("--friction", type=float, default=0.0, help="Coulomb μ between the bodies")
@@ -56,7 +60,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.repeat < 1:
         parser.error(f"--repeat must be at least 1, got {args.repeat}")
     from arlequin.demos.ball_impact import run_ball_impact
-    from arlequin.models.j2_kernel import warm_up
+    from arlequin.models.plasticity.j2_kernel import warm_up
 
     warm_up()
     common = dict(regime=args.regime, block_radius=args.block_size,

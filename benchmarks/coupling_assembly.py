@@ -1,7 +1,8 @@
 """Cost of building a patch's coupling (overlap, weights, coupling matrices) vs stiffness assembly.
 
 Patches of structured coarse meshes of the unit square / cube, nested
-(:func:`arlequin.patches.refine_region` of the middle box [0.25, 0.75]^d) or not; gluing band one
+(:func:`arlequin.coupling.patches.refine_region` of the middle box [0.25, 0.75]^d) or not; gluing
+band one
 coarse cell wide:
 
 ``2d``         56 × 56 squares split into triangles (6272 cells), the patch refined 3 times:
@@ -20,10 +21,10 @@ For each, in one process:
 * ``coupling``: ``ArlequinProblem(coarse, [Patch(fine, ...)]).couplings`` — builds the overlap,
   classifies the patch boundary, selects the gluing zone, evaluates the partition weights and
   assembles the coupling matrices (H1, coarse mediator, ramp weights). Phases are timed by
-  wrapping (at run time, without editing the library) ``arlequin.gluing.build_overlap``,
+  wrapping (at run time, without editing the library) ``arlequin.coupling.gluing.build_overlap``,
   ``PatchCoupling._classify_boundary``, ``PatchCoupling._fine_gluing_zone``,
-  ``PatchCoupling._evaluate_weights`` and ``arlequin.gluing.coupling_matrices``; ``other`` is the
-  rest of the constructor (mainly the integration model's basis).
+  ``PatchCoupling._evaluate_weights`` and ``arlequin.coupling.gluing.coupling_matrices``; ``other``
+  is the rest of the constructor (mainly the integration model's basis).
 * ``skfem``: scikit-fem's own linear-elasticity assembly of the fine stiffness on the patch mesh
   (``Basis`` construction + ``asm(linear_elasticity)``), at scikit-fem's default quadrature and
   at the model's quadrature order (3, also used by the coupling);
@@ -72,10 +73,10 @@ import trimesh  # noqa: F401
 from skfem import Basis, ElementTetP1, ElementTriP1, ElementVector, MeshTet, MeshTri, asm
 from skfem.models.elasticity import lame_parameters, linear_elasticity
 
-import arlequin.gluing as problem_module
+import arlequin.coupling.gluing as problem_module
+from arlequin.coupling.patches import refine_region
 from arlequin.models import IsotropicElastic, LinearElastic
-from arlequin.patches import refine_region
-from arlequin.problem import ArlequinProblem, Patch, PatchCoupling
+from arlequin.problem.arlequin_problem import ArlequinProblem, Patch, PatchCoupling
 
 YOUNG, POISSON = 200e9, 0.3  # steel (Pa, -)
 
@@ -212,7 +213,7 @@ def run_case(case: str, repeat: int = 3, profile: bool = False) -> dict:
         kind = "plane_strain" if dim == 2 else "3d"
         return LinearElastic(fine_mesh, IsotropicElastic(YOUNG, POISSON), kind=kind).stiffness()
 
-    from arlequin.clip3d import warm_up
+    from arlequin.geometry.clip3d import warm_up
 
     warm_up()  # numba's compilation (or cache load) out of the timings
     k = skfem_model_order()

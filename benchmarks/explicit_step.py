@@ -30,8 +30,8 @@ import time
 import numpy as np
 
 from arlequin.demos.cantilever import build_cantilever
-from arlequin.integrators import CentralDifference
-from arlequin.system import Block, BlockTerm, CoupledSystem, LinearConstraint
+from arlequin.problem.system import Block, BlockTerm, CoupledSystem, LinearConstraint
+from arlequin.solvers import CentralDifference
 
 logger = logging.getLogger("explicit_step")
 

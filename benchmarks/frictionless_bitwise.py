@@ -9,6 +9,7 @@ explicit), and pickles their computed arrays. Run it with the old version first:
     python benchmarks/frictionless_bitwise.py new.pkl
     python benchmarks/frictionless_bitwise.py --compare old.pkl new.pkl
 """
+
 import pickle
 import sys
 import warnings
@@ -49,7 +50,8 @@ for dim in (2, 3):
         cfl = {"cfl": 0.9} if integ == "explicit" else {}
         b = run_block_impact(dim=dim, target=target, integrator=integ, **cfl)
         out[f"block_{dim}_{target}_{integ}"] = {
-            k: np.asarray(v) for k, v in vars(b).items()
+            k: np.asarray(v)
+            for k, v in vars(b).items()
             if isinstance(v, (np.ndarray, list)) and np.asarray(v).dtype.kind == "f"
         }
 with open(sys.argv[1], "wb") as f:

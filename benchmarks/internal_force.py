@@ -40,8 +40,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--repeat", type=int, default=5)
     args = parser.parse_args(argv)
     nz = round(args.nr * 32.4 / 3.2)
-    mesh = skfem.MeshQuad.init_tensor(np.linspace(0, 3.2e-3, args.nr + 1),
-                                      np.linspace(0, 32.4e-3, nz + 1))
+    mesh = skfem.MeshQuad.init_tensor(
+        np.linspace(0, 3.2e-3, args.nr + 1), np.linspace(0, 32.4e-3, nz + 1)
+    )
     linear = LinearElastic(mesh, COPPER.elastic, kind="axisymmetric", intorder=3)
     k = linear.stiffness()
     record: dict = {"cells": int(mesh.t.shape[1])}

@@ -17,8 +17,8 @@ import sys
 import time
 import warnings
 
+from arlequin.coupling.gluing import ExactnessWarning
 from arlequin.demos.patch_test import run_patch_test
-from arlequin.gluing import ExactnessWarning
 
 
 def case(ratio: int, band: int, mediator: str) -> dict:

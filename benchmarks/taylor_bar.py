@@ -184,8 +184,13 @@ def main(argv: list[str] | None = None) -> int:
                         help="Arlequin vs the uniform mesh, N fine cells across")  # fmt: skip
     parser.add_argument("--coarse-size", type=float, default=None,
                         help="with --compare: the Arlequin coarse size (m)")  # fmt: skip
-    parser.add_argument("--coarse-step-ratio", type=int, default=1, metavar="M",
-                        help="with --compare: also the Arlequin run with multi-time-step M")
+    parser.add_argument(
+        "--coarse-step-ratio",
+        type=int,
+        default=1,
+        metavar="M",
+        help="with --compare: also the Arlequin run with multi-time-step M",
+    )
     parser.add_argument("--geometry", choices=["axisymmetric", "3d"], default="axisymmetric")
     parser.add_argument("--patch-length", type=float, default=None,
                         help="with --compare: the Arlequin patch length (m)")  # fmt: skip
@@ -196,23 +201,26 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--no-fbar", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.compare is not None:
-        from arlequin.models.j2_kernel import warm_up
-        from arlequin.models.j2_kernel_3d import warm_up_solid
+        from arlequin.models.plasticity.j2_kernel import warm_up
+        from arlequin.models.plasticity.j2_kernel_3d import warm_up_solid
 
         warm_up_solid() if args.geometry == "3d" else warm_up()
         if args.repeat < 1:
             parser.error(f"--repeat must be at least 1, got {args.repeat}")
         out = compare(args.compare, args.coarse_size, args.coarse_step_ratio, args.geometry,
                       args.patch_length, args.repeat)  # fmt: skip
-        print(json.dumps({"benchmark": "taylor_bar_compare", **out,
-                          "threads": _threads.settings()}, indent=2))
+        print(
+            json.dumps(
+                {"benchmark": "taylor_bar_compare", **out, "threads": _threads.settings()}, indent=2
+            )
+        )
         return 0
     if args.single is not None:
         print(json.dumps(one_level(args.single, not args.no_fbar, args.window, args.geometry)))
         return 0
     # compile (or load) the kernel once, outside every measurement
-    from arlequin.models.j2_kernel import warm_up
-    from arlequin.models.j2_kernel_3d import warm_up_solid
+    from arlequin.models.plasticity.j2_kernel import warm_up
+    from arlequin.models.plasticity.j2_kernel_3d import warm_up_solid
 
     warm_up_solid() if args.geometry == "3d" else warm_up()
     records = []
@@ -225,8 +233,11 @@ def main(argv: list[str] | None = None) -> int:
         out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
         records.append(json.loads(out.strip().splitlines()[-1]))
         print(json.dumps(records[-1]), file=sys.stderr, flush=True)
-    print(json.dumps({"benchmark": "taylor_bar", "levels": records,
-                      "threads": _threads.settings()}, indent=2))
+    print(
+        json.dumps(
+            {"benchmark": "taylor_bar", "levels": records, "threads": _threads.settings()}, indent=2
+        )
+    )
     return 0
 
 

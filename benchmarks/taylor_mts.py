@@ -24,7 +24,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--repeat", type=int, default=2)
     args = parser.parse_args(argv)
     from arlequin.demos.taylor_bar import GluingBandPlasticityWarning, run_taylor_bar
-    from arlequin.models.j2_kernel import warm_up
+    from arlequin.models.plasticity.j2_kernel import warm_up
 
     warm_up()
     runs: dict[int, list] = {1: [], args.ratio: []}

@@ -39,7 +39,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     from arlequin.demos.taylor_bar import GluingBandPlasticityWarning, run_taylor_bar
     from arlequin.demos.taylor_meshes import arlequin_bar_sizes
-    from arlequin.models.j2_kernel import warm_up
+    from arlequin.models.plasticity.j2_kernel import warm_up
 
     warm_up()
     n = args.elements_radial

@@ -29,21 +29,23 @@ def sweep(cfls: list[float], elements: int) -> list[dict]:
         bars = run_two_bars(cfl=cfl, elements=elements)
         wall = run_wall(cfl=cfl, elements=elements)
         mb, mw = bars.metrics(), wall.metrics()
-        records.append({
-            "cfl": cfl,
-            "elements": elements,
-            "steps": len(bars.t) - 1,
-            "dispersion_coefficient": (1.0 - 2.0 * cfl**2) / 24.0,
-            "bars_pressure_rms_error": mb["pressure_rms_error"],
-            "bars_velocity_rms_error": mb["velocity_rms_error"],
-            "bars_duration_error_steps": mb["duration_error_steps"],
-            "bars_final_velocities": list(bars.final_velocities),
-            "bars_energy_loss": mb["energy_loss"],
-            "wall_pressure_rms_error": mw["pressure_rms_error"],
-            "wall_rebound": float(wall.final_velocities[0]),
-            "wall_duration_error_steps": mw["duration_error_steps"],
-            "wall_time_s": time.perf_counter() - t0,
-        })
+        records.append(
+            {
+                "cfl": cfl,
+                "elements": elements,
+                "steps": len(bars.t) - 1,
+                "dispersion_coefficient": (1.0 - 2.0 * cfl**2) / 24.0,
+                "bars_pressure_rms_error": mb["pressure_rms_error"],
+                "bars_velocity_rms_error": mb["velocity_rms_error"],
+                "bars_duration_error_steps": mb["duration_error_steps"],
+                "bars_final_velocities": list(bars.final_velocities),
+                "bars_energy_loss": mb["energy_loss"],
+                "wall_pressure_rms_error": mw["pressure_rms_error"],
+                "wall_rebound": float(wall.final_velocities[0]),
+                "wall_duration_error_steps": mw["duration_error_steps"],
+                "wall_time_s": time.perf_counter() - t0,
+            }
+        )
     return records
 
 

@@ -56,8 +56,14 @@ def _example_page(script: Path) -> str:
         ):
             images = list(ast.literal_eval(node.value))
     first, _, rest = doc.partition("\n\n")
-    lines = [f"# {' '.join(first.split())}", "", rest.strip(), "",
-             f"Run it: `python examples/{script.name}`.", ""]
+    lines = [
+        f"# {' '.join(first.split())}",
+        "",
+        rest.strip(),
+        "",
+        f"Run it: `python examples/{script.name}`.",
+        "",
+    ]
     for img in images:
         lines += [f"![{Path(img).stem}](../{img})", ""]
     lines += [f"```{{literalinclude}} ../../examples/{script.name}", ":language: python", "```", ""]

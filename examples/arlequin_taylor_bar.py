@@ -16,7 +16,6 @@ import numpy as np
 import skfem
 
 import arlequin
-from arlequin.integrators import CriticalFraction, solve
 from arlequin.models import (
     ContactSurface,
     FiniteStrainJ2,
@@ -27,6 +26,7 @@ from arlequin.models import (
     RigidContactPair,
     make_hardening,
 )
+from arlequin.solvers import CriticalFraction, solve
 
 #: The pictures of this example in the documentation's gallery (paths under docs/).
 GALLERY_IMAGES = ["gallery/arlequin_taylor_bar.png", "gallery/arlequin_taylor_bar_history.png"]

@@ -24,7 +24,6 @@ import numpy as np
 import skfem
 
 import arlequin
-from arlequin.integrators import solve
 from arlequin.models import (
     ContactSurface,
     DeformableContactPair,
@@ -34,6 +33,7 @@ from arlequin.models import (
     LevelSetContact,
     LinearElastic,
 )
+from arlequin.solvers import solve
 
 #: The pictures of this example in the documentation's gallery (paths under docs/).
 GALLERY_IMAGES = ["gallery/ball_impact.png"]
@@ -54,7 +54,7 @@ def ball_mesh(radius: float, n: int) -> skfem.MeshQuad:
         th = np.radians(np.linspace(t0, t1, k + 1))
         arc = radius * np.stack([np.cos(th), np.sin(th)])
         w = np.linspace(0.0, 1.0, n + 1)
-        p = ((1 - w)[None, :, None] * edge[:, None, :] + w[None, :, None] * arc[:, None, :])
+        p = (1 - w)[None, :, None] * edge[:, None, :] + w[None, :, None] * arc[:, None, :]
         i, j = np.meshgrid(np.arange(k), np.arange(n), indexing="ij")
         a = (j * (k + 1) + i).ravel()
         pts.append(p.reshape(2, -1))
@@ -70,8 +70,13 @@ def ball_mesh(radius: float, n: int) -> skfem.MeshQuad:
     return skfem.MeshQuad(np.ascontiguousarray(p), np.ascontiguousarray(inverse.ravel()[t]))
 
 
-def run(n: int = 20, levels: int = 2, velocity: float | None = None,
-        block_size: float | None = None, plastic: bool = False) -> dict:
+def run(
+    n: int = 20,
+    levels: int = 2,
+    velocity: float | None = None,
+    block_size: float | None = None,
+    plastic: bool = False,
+) -> dict:
     """Peak contact force (N) and contact duration (s) of a steel ball (R = 10 mm) striking a
     block (radius = height = ``block_size``, default 10 R, or 2 R when plastic) at ``velocity``
     (m/s, default 1, or 10 when plastic), with Hertz's values (the elastic steel block) or the
@@ -183,9 +188,11 @@ def run(n: int = 20, levels: int = 2, velocity: float | None = None,
     # 7. the dent (the block's top point on the axis) and the patch's plastic strain
     pole = int(np.nonzero((block_patch.p[0] < tol) & (block_patch.p[1] > -tol))[0][0])
     state = res.states["block.patch"][0]
-    out.update(dent_depth=float(-res.u[dm["block.patch"].offset + 2 * pole + 1]),
-               restitution=out["rebound_velocity"] / velocity,
-               max_plastic_strain=float(state.eqps.max()))
+    out.update(
+        dent_depth=float(-res.u[dm["block.patch"].offset + 2 * pole + 1]),
+        restitution=out["rebound_velocity"] / velocity,
+        max_plastic_strain=float(state.eqps.max()),
+    )
     return out
 
 

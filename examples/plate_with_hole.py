@@ -48,10 +48,10 @@ import time
 import numpy as np
 import skfem
 
-from arlequin.integrators.static import solve_static
+from arlequin.coupling.patches import refine_region
 from arlequin.models import IsotropicElastic, LinearElastic
-from arlequin.patches import refine_region
-from arlequin.problem import ArlequinProblem, Patch
+from arlequin.problem.arlequin_problem import ArlequinProblem, Patch
+from arlequin.solvers.static import solve_static
 
 __all__ = ["project_hole_nodes", "quarter_plate_mesh", "refine_projected", "run"]
 
@@ -225,7 +225,7 @@ def run(
         Width of the gluing band in coarse rings (measured on the x axis, where rings are
         thinnest), inside the patch along its outer edge.
     coupling, mediator, weights : str
-        Patch options (:class:`arlequin.problem.Patch`).
+        Patch options (:class:`arlequin.problem.arlequin_problem.Patch`).
     length : float, optional
         H1 coupling length ℓ (m); default: the library's default.
     element : {"tri", "quad"}

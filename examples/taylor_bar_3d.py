@@ -18,8 +18,8 @@ import numpy as np
 import trimesh
 
 import arlequin
+from arlequin.coupling.patches import select_cells
 from arlequin.demos.taylor_meshes_3d import quarter_bar_mesh, refined_bar_mesh
-from arlequin.integrators import CriticalFraction, solve
 from arlequin.models import (
     ContactSurface,
     FiniteStrainJ2,
@@ -30,7 +30,7 @@ from arlequin.models import (
     RigidContactPair,
     make_hardening,
 )
-from arlequin.patches import select_cells
+from arlequin.solvers import CriticalFraction, solve
 
 L, R, V0 = 32.4e-3, 3.2e-3, 227.0
 

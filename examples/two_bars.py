@@ -23,16 +23,26 @@ DOCS = Path(__file__).resolve().parent.parent / "docs"
 
 def _fig(r) -> dict:
     m = r.metrics()
-    keys = ("velocity_rms_error", "pressure_rms_error", "duration_error_steps",
-            "final_velocity_error", "energy_loss", "max_energy_gain")
+    keys = (
+        "velocity_rms_error",
+        "pressure_rms_error",
+        "duration_error_steps",
+        "final_velocity_error",
+        "energy_loss",
+        "max_energy_gain",
+    )
     out = {k: m[k] for k in keys}
     out["final_velocities"] = r.final_velocities
     out["mean_iterations"] = float(r.fixed_point_iterations[1:].mean())
     return out
 
 
-def run(elements: int = 100, refinement=(25, 50, 100, 200, 400), blocks: bool = True,
-        plot: str | None = None) -> dict:
+def run(
+    elements: int = 100,
+    refinement=(25, 50, 100, 200, 400),
+    blocks: bool = True,
+    plot: str | None = None,
+) -> dict:
     """All the figures of docs/contact.md (fractions, steps, m/s)."""
     out: dict = {}
     both = run_two_bars(method="both", elements=elements)
@@ -42,13 +52,15 @@ def run(elements: int = 100, refinement=(25, 50, 100, 200, 400), blocks: bool = 
         "newmark-trapezoidal": _fig(both.newmark),
         "newmark-hht": _fig(hht),
         "levelset-theta1": _fig(run_two_bars(theta=1.0, elements=elements)),
-        "levelset-explicit-cfl0.9": _fig(run_two_bars(integrator="explicit", cfl=0.9,
-                                                      elements=elements)),
+        "levelset-explicit-cfl0.9": _fig(
+            run_two_bars(integrator="explicit", cfl=0.9, elements=elements)
+        ),
     }
     out["wall"] = {
         "levelset-theta": _fig(run_wall(elements=elements)),
-        "levelset-explicit-cfl0.9": _fig(run_wall(integrator="explicit", cfl=0.9,
-                                                  elements=elements)),
+        "levelset-explicit-cfl0.9": _fig(
+            run_wall(integrator="explicit", cfl=0.9, elements=elements)
+        ),
         "newmark-trapezoidal": _fig(run_wall(method="newmark", elements=elements)),
         "newmark-hht": _fig(run_wall(method="newmark", newmark="hht", elements=elements)),
     }
@@ -57,9 +69,17 @@ def run(elements: int = 100, refinement=(25, 50, 100, 200, 400), blocks: bool = 
     }
     if blocks:
         rows = {}
-        for dim, target, ne in ((2, "plane", 20), (2, "plane", 40), (2, "plane", 80),
-                                (2, "block", 20), (2, "block", 40), (3, "plane", 20),
-                                (3, "plane", 40), (3, "block", 20), (3, "block", 40)):
+        for dim, target, ne in (
+            (2, "plane", 20),
+            (2, "plane", 40),
+            (2, "plane", 80),
+            (2, "block", 20),
+            (2, "block", 40),
+            (3, "plane", 20),
+            (3, "plane", 40),
+            (3, "block", 20),
+            (3, "block", 40),
+        ):
             r = run_block_impact(dim, target, ne)
             rows[f"{dim}D-{target}-{ne}"] = {
                 "energy_loss": r.energy_loss,

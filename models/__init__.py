@@ -13,7 +13,15 @@ laws), ``j2`` (the J2 material point), ``kinematics`` (finite-strain Q1 kinemati
 ``friction`` (Coulomb friction in the level-set model).
 """
 
-from .contact import (
+from .contact.friction import CoulombContact, FrictionState
+from .contact.geometry import (
+    ContactGeometry,
+    ContactPair,
+    ContactSurface,
+    DeformableContactPair,
+    RigidContactPair,
+)
+from .contact.level_set import (
     ContactConvergenceError,
     ContactHistory,
     ContactRecord,
@@ -22,13 +30,7 @@ from .contact import (
     SignoriniContact,
     acoustic_impedance,
 )
-from .contact_geometry import (
-    ContactGeometry,
-    ContactPair,
-    ContactSurface,
-    DeformableContactPair,
-    RigidContactPair,
-)
+from .contact.obstacles import LevelSetObstacle, Obstacle, PlaneObstacle, SphereObstacle
 from .elastic import (
     KINDS,
     IsotropicElastic,
@@ -36,9 +38,8 @@ from .elastic import (
     element_critical_step,
     scalar_element_for,
 )
-from .elastoplastic import BACKENDS, BulkViscosity, FiniteStrainJ2
-from .friction import CoulombContact, FrictionState
-from .hardening import (
+from .plasticity.finite_strain_j2 import BACKENDS, BulkViscosity, FiniteStrainJ2
+from .plasticity.hardening import (
     HARDENING_LAWS,
     CallableHardening,
     Hardening,
@@ -47,7 +48,7 @@ from .hardening import (
     VoceHardening,
     make_hardening,
 )
-from .j2 import (
+from .plasticity.j2 import (
     InvertedElementError,
     J2Material,
     PlasticState,
@@ -56,8 +57,7 @@ from .j2 import (
     j2_return_map,
     j2_update,
 )
-from .kinematics import Q1Kinematics
-from .obstacles import LevelSetObstacle, Obstacle, PlaneObstacle, SphereObstacle
+from .plasticity.kinematics import Q1Kinematics
 
 __all__ = [
     "BACKENDS",

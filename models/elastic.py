@@ -29,8 +29,8 @@ import scipy.sparse as sp
 from skfem import Basis, BilinearForm, ElementVector, FacetBasis, LinearForm, Mesh
 from skfem.helpers import dot, grad
 
-from arlequin.meshcheck import check_mesh
-from arlequin.reference import scalar_element_for
+from arlequin.geometry.meshcheck import check_mesh
+from arlequin.geometry.reference import scalar_element_for
 
 __all__ = [
     "KINDS",
@@ -111,7 +111,7 @@ class LinearElastic:
         Quadrature order (polynomial degree integrated exactly). Default 3 (4 for hexahedra):
         exact for a first-order weight times the stiffness of a linear field on P1/Q1 cells.
     validate : bool
-        Check the mesh (:func:`arlequin.meshcheck.check_mesh`: non-finite or unused nodes,
+        Check the mesh (:func:`arlequin.geometry.meshcheck.check_mesh`: non-finite or unused nodes,
         degenerate and folded cells, coincident nodes) and raise ``MeshError`` naming the node
         or cell.
     allow_seams : bool

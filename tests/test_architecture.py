@@ -25,10 +25,9 @@ MODELS = ROOT.parent / "models"
 #: What models may import from the core (besides themselves): the contract and pure helpers.
 MODEL_ALLOWED = {
     "arlequin.contract",
-    "arlequin.dofs",
-    "arlequin.reference",
-    "arlequin.geometry",
-    "arlequin.meshcheck",
+    "arlequin.geometry.reference",
+    "arlequin.geometry.facets",
+    "arlequin.geometry.meshcheck",
 }
 
 
@@ -91,7 +90,9 @@ def violations(importer, forbidden) -> list[tuple[str, str]]:
 
 def test_core_outside_demos_and_cli_never_imports_models():
     bad = violations(
-        lambda m: not m.startswith(("arlequin.models", "arlequin.demos")) and m != "arlequin.cli",
+        lambda m: (
+            not m.startswith(("arlequin.models", "arlequin.demos")) and m != "arlequin.cli.main"
+        ),
         lambda d: d.startswith("arlequin.models"),
     )
     assert not bad, bad
@@ -107,9 +108,14 @@ def test_models_import_only_the_contract_and_pure_helpers():
 
 def test_integrators_do_not_import_the_results_layer_or_the_problem():
     bad = violations(
-        lambda m: m.startswith("arlequin.integrators"),
+        lambda m: m.startswith("arlequin.solvers"),
         lambda d: d.startswith(
-            ("arlequin.io", "arlequin.problem", "arlequin.gluing", "arlequin.demos")
+            (
+                "arlequin.io",
+                "arlequin.problem.arlequin_problem",
+                "arlequin.coupling.gluing",
+                "arlequin.demos",
+            )
         ),
     )
     assert not bad, bad
@@ -118,8 +124,10 @@ def test_integrators_do_not_import_the_results_layer_or_the_problem():
 def test_results_layer_imports_only_the_dof_layout_and_the_mesh_checks():
     bad = violations(
         lambda m: m.startswith("arlequin.io"),
-        lambda d: not d.startswith("arlequin.io") and d not in ("arlequin.dofs",
-                                                                 "arlequin.meshcheck"),
+        lambda d: (
+            not d.startswith("arlequin.io")
+            and d not in ("arlequin.dofs", "arlequin.geometry.meshcheck")
+        ),
     )
     assert not bad, bad
 
@@ -147,16 +155,40 @@ def test_no_import_cycle():
     assert not cycles, cycles
 
 
-def test_modules_stay_small_or_say_why():
+#: The compiled kernels (numba, one fused loop each), exempt from the function-size rule.
+KERNELS = {
+    "arlequin.geometry.clip3d._clip_one",
+    "arlequin.models.plasticity.j2_kernel.planar_j2_kernel",
+    "arlequin.models.plasticity.j2_kernel_3d.solid_j2_kernel",
+}
+
+
+def test_modules_stay_under_600_lines():
     long = []
     for name, path in all_modules().items():
         n_lines = len(path.read_text(encoding="utf-8").splitlines())
-        if n_lines <= 500:
-            continue
-        doc = ast.get_docstring(ast.parse(path.read_text(encoding="utf-8"))) or ""
-        if not any(line.startswith("Size:") for line in doc.splitlines()):
+        if n_lines > 600:
             long.append((name, n_lines))
     assert not long, long
+
+
+def test_functions_stay_under_100_lines():
+    """Outside the compiled kernels, no function over 100 lines (the complexity bound, 20, is
+    ruff's C901 in pyproject.toml)."""
+    long = []
+    for name, path in all_modules().items():
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                n_lines = node.end_lineno - node.lineno + 1
+                if n_lines > 100 and f"{name}.{node.name}" not in KERNELS:
+                    long.append((f"{name}.{node.name}", n_lines))
+    assert not long, long
+
+
+def test_demos_are_packages():
+    """``arlequin/demos/`` holds one package a demo and at most six top-level modules."""
+    top = [p.name for p in (ROOT / "demos").glob("*.py")]
+    assert len(top) <= 6, sorted(top)
 
 
 def test_the_architecture_page_names_every_module():

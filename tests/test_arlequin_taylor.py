@@ -21,7 +21,8 @@ import meshio  # noqa: F401  (the XDMF reader below needs it)
 import numpy as np
 import pytest
 
-from arlequin.cli import main
+from arlequin.cli.main import main
+from arlequin.coupling.weights import RampWeights
 from arlequin.demos.taylor_bar import (
     ARLEQUIN_JSON_KEYS,
     JSON_KEYS,
@@ -32,7 +33,6 @@ from arlequin.demos.taylor_meshes import arlequin_bar_sizes
 from arlequin.demos.taylor_models import ArlequinBar
 from arlequin.io import read_series
 from arlequin.models import J2Material, make_hardening
-from arlequin.weights import RampWeights
 
 L, R = 32.4e-3, 3.2e-3
 
@@ -195,7 +195,7 @@ def test_graded_mesh_is_conforming_and_covers_the_bar(fine):
     import skfem
 
     from arlequin.demos.taylor_meshes import graded_bar_mesh
-    from arlequin.meshcheck import check_mesh
+    from arlequin.geometry.meshcheck import check_mesh
 
     s = arlequin_bar_sizes(L, R, fine)
     mesh = graded_bar_mesh(L, R, s)
@@ -209,8 +209,9 @@ def test_graded_mesh_is_conforming_and_covers_the_bar(fine):
     # fine cells over the patch region, 2:1 templates (6 quads per 2 coarse columns) above it
     n_fine = fine * 2 * s.patch_rows
     n_transition = 6 * (s.coarse_radial // 2) + 2 * (s.coarse_radial % 2)
-    assert mesh.nelements == n_fine + n_transition + columns_above * (s.coarse_axial
-                                                                       - s.patch_rows - 1)
+    assert mesh.nelements == n_fine + n_transition + columns_above * (
+        s.coarse_axial - s.patch_rows - 1
+    )
 
 
 def test_graded_mesh_needs_a_ratio_of_two():

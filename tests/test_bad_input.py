@@ -6,12 +6,12 @@ import numpy as np
 import pytest
 import skfem
 
-from arlequin.coupling import MediatorError, coupling_matrices
+from arlequin.coupling.mediators import MediatorError, coupling_matrices
+from arlequin.coupling.overlap import OverlapError
+from arlequin.coupling.patches import refine_region
+from arlequin.coupling.weights import CallableWeights, WeightSumError
 from arlequin.models import IsotropicElastic, LinearElastic
-from arlequin.overlap import OverlapError
-from arlequin.patches import refine_region
-from arlequin.problem import ArlequinProblem, Patch
-from arlequin.weights import CallableWeights, WeightSumError
+from arlequin.problem.arlequin_problem import ArlequinProblem, Patch
 
 STEEL = IsotropicElastic(young=210e9, poisson=0.3, density=7850.0)
 

@@ -16,7 +16,7 @@ import pytest
 import skfem
 
 from arlequin import ArlequinProblem, MultiBodyProblem
-from arlequin.cli import main
+from arlequin.cli.main import main
 from arlequin.demos.ball_impact import STEEL, run_ball_impact
 from arlequin.demos.ball_meshes import (
     ball_patch_mesh,
@@ -26,9 +26,9 @@ from arlequin.demos.ball_meshes import (
 )
 from arlequin.demos.ball_record import hertz_force_history
 from arlequin.demos.ball_result import JSON_KEYS, hertz
-from arlequin.integrators import solve
-from arlequin.meshcheck import corner_jacobians
+from arlequin.geometry.meshcheck import corner_jacobians
 from arlequin.models import IsotropicElastic, LinearElastic
+from arlequin.solvers import solve
 
 R = 0.01
 #: A coarse set-up that runs in seconds: O-grid n = 20, two refinements (4 fine cells per
@@ -246,7 +246,7 @@ def test_a_zoned_body_has_one_law_per_cell():
     # mesh's dofs, plus the elastic one of the other cells on the zone's nodes
     from arlequin.demos.ball_impact import COPPER
     from arlequin.demos.ball_zoned import ZonedBody
-    from arlequin.integrators.operators import SystemOperators
+    from arlequin.solvers.operators import SystemOperators
 
     mesh = skfem.MeshQuad.init_tensor(np.linspace(0, 0.01, 9), np.linspace(-0.01, 0, 9))
     centres = mesh.p[:, mesh.t].mean(axis=1)

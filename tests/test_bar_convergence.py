@@ -14,10 +14,10 @@ import numpy as np
 import pytest
 import skfem
 
-from arlequin.integrators.static import solve_static
+from arlequin.coupling.patches import refine_region
 from arlequin.models import IsotropicElastic, LinearElastic
-from arlequin.patches import refine_region
-from arlequin.problem import ArlequinProblem, Patch
+from arlequin.problem.arlequin_problem import ArlequinProblem, Patch
+from arlequin.solvers.static import solve_static
 
 E, F0 = 1.0e9, 1.0e6
 

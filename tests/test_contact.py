@@ -1,4 +1,5 @@
-"""Unit tests of the level-set contact model (models/contact.py): geometry, statuses, protocol."""
+"""Unit tests of the level-set contact model (models/contact/level_set.py): geometry, statuses,
+protocol."""
 
 from __future__ import annotations
 
@@ -9,7 +10,6 @@ import pytest
 import scipy.sparse as sp
 import skfem
 
-from arlequin.integrators import solve
 from arlequin.models import (
     ContactConvergenceError,
     ContactSurface,
@@ -24,7 +24,8 @@ from arlequin.models import (
     SphereObstacle,
     acoustic_impedance,
 )
-from arlequin.system import Block, BlockTerm, CoupledSystem
+from arlequin.problem.system import Block, BlockTerm, CoupledSystem
+from arlequin.solvers import solve
 
 STEEL = IsotropicElastic(210e9, 0.3, 7850.0)
 

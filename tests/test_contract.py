@@ -29,7 +29,6 @@ from arlequin.contract import (
     UnilateralConstraint,
     capabilities,
 )
-from arlequin.integrators import LinearInequality, solve, stable_time_step
 from arlequin.models import (
     ContactSurface,
     FiniteStrainJ2,
@@ -41,7 +40,8 @@ from arlequin.models import (
     RigidContactPair,
     SignoriniContact,
 )
-from arlequin.system import Block, BlockTerm, CoupledSystem
+from arlequin.problem.system import Block, BlockTerm, CoupledSystem
+from arlequin.solvers import LinearInequality, solve, stable_time_step
 
 STEEL = IsotropicElastic(210e9, 0.3, 7850.0)
 COPPER = J2Material(117e9, 0.35, 8930.0, 0.4e9, 0.1e9)
@@ -257,7 +257,7 @@ def test_models_that_use_the_time_step_receive_it(scheme):
     model = _RecordsTimeStep(bar)
     system = CoupledSystem([Block("b", model, [BlockTerm(model)])])
     steps = [1e-6, 2e-6, 1.5e-6]
-    from arlequin.integrators import StepSchedule
+    from arlequin.solvers import StepSchedule
 
     with pytest.raises(ValueError, match="StepSchedule needs a function"):
         StepSchedule(steps)

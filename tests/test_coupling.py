@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from arlequin.coupling import coupling_matrices
+from arlequin.coupling.mediators import coupling_matrices
 from arlequin.demos.patch_test import build_patch_test_problem
 
 CASES = [
@@ -86,7 +86,7 @@ def test_scalar_l2_gram_sums_to_gluing_measure(dim, mesh, mediator):
 def test_closed_form_gram_is_the_quadrature(dim, mesh, coupling):
     # the closed form of P1 simplices against scikit-fem's quadrature of the same form (order
     # 2: exact for products of two P1 functions), to round-off
-    from arlequin.coupling import gram_matrix
+    from arlequin.coupling.mediators import gram_matrix
 
     problem, _ = build_patch_test_problem(dim, coupling, "ramp", "coarse", mesh, seed=4)
     pc = problem.couplings[0]

@@ -15,9 +15,9 @@ import pytest
 import scipy.linalg as sla
 import skfem
 
-from arlequin.integrators import RayleighDamping, solve
-from arlequin.integrators.operators import as_system
 from arlequin.models import IsotropicElastic, LinearElastic
+from arlequin.solvers import RayleighDamping, solve
+from arlequin.solvers.operators import as_system
 
 MAT = IsotropicElastic(1.0, 0.0, 1.0)
 
@@ -57,10 +57,10 @@ def test_a_damped_mode_follows_the_scheme_recurrence_and_the_continuous_decay():
     dt = 20 * period / n
     r = solve(model, "explicit", n_steps=n, dt=dt, u0=phi, damping=damping, record_every=n)
     x, v = 1.0, 0.0
-    v = v + 0.5 * dt * (-omega**2 * x)  # the first half step (v^{-1/2} = v^0 = 0)
+    v = v + 0.5 * dt * (-(omega**2) * x)  # the first half step (v^{-1/2} = v^0 = 0)
     for _ in range(n):
         x = x + dt * v
-        v = v + dt * (-omega**2 * x - 2 * xi * omega * v)
+        v = v + dt * (-(omega**2) * x - 2 * xi * omega * v)
     amp = float(phi @ (m * r.u))  # φ is M-orthonormal
     assert amp == pytest.approx(x, rel=1e-9, abs=1e-12)
     # the continuous damped oscillator (ω Δt = 0.031: the scheme's error is O((ω Δt)²))

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from arlequin.demos.cantilever import build_cantilever
-from arlequin.integrators import solve
+from arlequin.solvers import solve
 
 CASES = [(ratio, integ) for ratio in (0.75, 0.5) for integ in ("explicit", "newmark")]
 

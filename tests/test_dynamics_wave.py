@@ -135,7 +135,7 @@ def test_wave_refuses_unstable_user_step():
 
 
 def test_cli_wave_writes_json(tmp_path):
-    from arlequin.cli import main
+    from arlequin.cli.main import main
 
     out = tmp_path / "wave.json"
     png = tmp_path / "wave.png"

@@ -1,4 +1,5 @@
-"""Finite-strain J2 model (models/elastoplastic.py) against closed-form and exact properties.
+"""Finite-strain J2 model (models/plasticity/finite_strain_j2.py) against closed-form and exact
+properties.
 
 Reference values come from:
 * the closed-form uniaxial-strain response of Hencky J2 with linear hardening (for a fixed
@@ -17,7 +18,6 @@ import pytest
 import skfem
 from _meshes import perturb
 
-from arlequin.integrators import SimulationError, solve, stable_time_step
 from arlequin.models import (
     FiniteStrainJ2,
     InvertedElementError,
@@ -25,7 +25,8 @@ from arlequin.models import (
     LinearElastic,
     hencky_j2_return,
 )
-from arlequin.system import Block, BlockTerm, CoupledSystem
+from arlequin.problem.system import Block, BlockTerm, CoupledSystem
+from arlequin.solvers import SimulationError, solve, stable_time_step
 
 # Taylor-bar copper (DESIGN §4): E, ν, ρ, σ_y, H
 COPPER = J2Material(117e9, 0.35, 8930.0, 0.4e9, 0.1e9)
@@ -90,7 +91,7 @@ def test_uniaxial_strain_matches_closed_form(strain, steps, planar):
 
 def test_planar_eigen_decomposition_matches_lapack():
     # closed-form 2×2 + out-of-plane eigenpairs rebuild the tensor, degenerate cases included
-    from arlequin.models.j2 import _from_principal, _sym_eig_planar
+    from arlequin.models.plasticity.j2 import _from_principal, _sym_eig_planar
 
     rng = np.random.default_rng(8)
     a = np.zeros((3, 3, 50))
@@ -264,8 +265,10 @@ def test_small_amplitude_dynamics_match_linear_elasticity():
     # explicit central differences) follows the linear model to the size of the strains (~1e-7)
     mesh = mesh_for("axisymmetric", n=3)
     runs = []
-    for model in (FiniteStrainJ2(mesh, COPPER, fbar=False),
-                  LinearElastic(mesh, COPPER.elastic, kind="axisymmetric", intorder=3)):
+    for model in (
+        FiniteStrainJ2(mesh, COPPER, fbar=False),
+        LinearElastic(mesh, COPPER.elastic, kind="axisymmetric", intorder=3),
+    ):
         system = CoupledSystem([Block("bar", model, [BlockTerm(model)])], [])
         v0 = np.zeros(model.n_dofs)
         v0[model.dofs_where(lambda x: x[1] > 3e-3, components=[1])] = -1e-3

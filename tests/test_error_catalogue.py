@@ -9,10 +9,10 @@ import pytest
 import skfem
 
 from arlequin import ArlequinProblem, ContractError, Patch, solve, solve_static
-from arlequin.cli import main
-from arlequin.integrators import SingularSystemError
-from arlequin.meshcheck import MeshError
+from arlequin.cli.main import main
+from arlequin.geometry.meshcheck import MeshError
 from arlequin.models import IsotropicElastic, J2Material, LinearElastic
+from arlequin.solvers import SingularSystemError
 
 STEEL = IsotropicElastic(210e9, 0.3, 7850.0)
 

@@ -69,8 +69,14 @@ def test_two_bars_example_runs_small(tmp_path):
 
 
 # every example is run by the suite: the guard fails when a new one is not
-COVERED = {"refined_patch", "arlequin_taylor_bar", "two_bars", "plate_with_hole", "ball_on_block",
-           "taylor_bar_3d"}
+COVERED = {
+    "refined_patch",
+    "arlequin_taylor_bar",
+    "two_bars",
+    "plate_with_hole",
+    "ball_on_block",
+    "taylor_bar_3d",
+}
 
 
 def test_every_example_is_covered():

@@ -15,7 +15,9 @@ import scipy.sparse as sp
 import skfem
 from scipy.integrate import solve_ivp
 
-from arlequin.integrators import (
+from arlequin.models import IsotropicElastic, LinearElastic
+from arlequin.problem.system import Block, BlockTerm, CoupledSystem, LinearConstraint
+from arlequin.solvers import (
     REGISTRY,
     CentralDifference,
     ConstraintError,
@@ -29,8 +31,6 @@ from arlequin.integrators import (
     solve,
     stable_time_step,
 )
-from arlequin.models import IsotropicElastic, LinearElastic
-from arlequin.system import Block, BlockTerm, CoupledSystem, LinearConstraint
 
 E, RHO, AREA, LENGTH = 3.0, 1.5, 0.5, 2.0
 K = E * AREA / LENGTH
@@ -187,7 +187,7 @@ def test_prescribed_base_motion(name):
 
 def glued_bars(weights: str = "ramp", ratio: int = 3, coupling: str = "H1"):
     """A 1D Arlequin problem: coarse bar [0, 1] (12 elements), patch [0.5, 1], clamped at x=0."""
-    from arlequin.problem import ArlequinProblem, Patch
+    from arlequin.problem.arlequin_problem import ArlequinProblem, Patch
 
     mat = IsotropicElastic(210e9, 0.0, 7800.0)
     coarse = LinearElastic(skfem.MeshLine(np.linspace(0.0, 1.0, 13)), mat, area=1e-4)

@@ -1,5 +1,5 @@
-"""Exact tetrahedron–tetrahedron intersections (arlequin.intersect3d) against an independent
-construction: scipy's half-space intersection (Qhull) of the eight face planes."""
+"""Exact tetrahedron–tetrahedron intersections (arlequin.geometry.intersect3d) against an
+independent construction: scipy's half-space intersection (Qhull) of the eight face planes."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from scipy.optimize import linprog
 from scipy.spatial import ConvexHull, HalfspaceIntersection
 from skfem import MeshTet
 
-from arlequin.intersect3d import candidate_pairs, classify_pairs, tetrahedra_intersections
+from arlequin.geometry.intersect3d import candidate_pairs, classify_pairs, tetrahedra_intersections
 
 
 def _halfspaces(v: np.ndarray) -> np.ndarray:

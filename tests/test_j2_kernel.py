@@ -1,5 +1,5 @@
-"""The compiled J2 kernels (models/j2_kernel.py, planar; models/j2_kernel_3d.py, hexahedra)
-against the numpy reference path.
+"""The compiled J2 kernels (models/plasticity/j2_kernel.py, planar;
+models/plasticity/j2_kernel_3d.py, hexahedra) against the numpy reference path.
 
 Both evaluate the same formulas (Q1 kinematics with F-bar, b_e − 1 without round-off, the
 exponential-map return, the bulk viscosity, the consistent force), one point by point and one
@@ -192,8 +192,8 @@ def test_warm_up_compiles_every_signature_the_taylor_bar_uses(geometry, model, n
     # clock cost the 3D Arlequin bar 21 s of its 237 s with a cold cache (FiniteStrainJ2 passes
     # the weight as a read-only view, which the warm-up once passed writeable: another type)
     from arlequin.demos.taylor_bar import run_taylor_bar
-    from arlequin.models.j2_kernel import planar_j2_kernel, warm_up
-    from arlequin.models.j2_kernel_3d import solid_j2_kernel, warm_up_solid
+    from arlequin.models.plasticity.j2_kernel import planar_j2_kernel, warm_up
+    from arlequin.models.plasticity.j2_kernel_3d import solid_j2_kernel, warm_up_solid
 
     warm_up_solid() if geometry == "3d" else warm_up()
     kernel = solid_j2_kernel if geometry == "3d" else planar_j2_kernel

@@ -1,4 +1,4 @@
-"""Tests of arlequin.locate: the bounded-memory point locator.
+"""Tests of arlequin.geometry.locate: the bounded-memory point locator.
 
 Expected values come from construction: points are mapped from known (cell, reference) pairs,
 placed at known distances outside boxes whose boundary is not perturbed, or follow from the
@@ -15,8 +15,8 @@ import pytest
 import skfem
 from _meshes import perturb
 
-from arlequin.locate import LocateResult, cell_centroids, cell_sizes, locate_points
-from arlequin.reference import (
+from arlequin.geometry.locate import LocateResult, cell_centroids, cell_sizes, locate_points
+from arlequin.geometry.reference import (
     interpolation_matrix,
     map_to_physical,
     reference_element,

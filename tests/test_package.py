@@ -9,7 +9,7 @@ import sys
 from pathlib import Path
 
 import arlequin
-from arlequin.cli import main
+from arlequin.cli.main import main
 
 ROOT = Path(arlequin.__file__).resolve().parent
 
@@ -62,7 +62,7 @@ def test_cli_reports_errors_cleanly(capsys):
 
 def test_console_script_entry_point():
     r = subprocess.run(
-        [sys.executable, "-m", "arlequin.cli", "patch-test", "--dim", "1"],
+        [sys.executable, "-m", "arlequin.cli.main", "patch-test", "--dim", "1"],
         capture_output=True,
         text=True,
         check=False,
@@ -82,7 +82,7 @@ def test_models_import_from_the_repository_root_without_the_installed_mapping():
         "getattr(f, '__name__', type(f).__name__) and 'ditable' not in "
         "getattr(f, '__module__', '')]\n"
         f"sys.path.insert(0, {str(root)!r})\n"
-        "import arlequin.models, arlequin.models.contact\n"
+        "import arlequin.models, arlequin.models.contact.level_set\n"
         "print(arlequin.__file__)\n"
         "print(arlequin.models.__file__)\n"
     )
@@ -99,7 +99,7 @@ def test_version_and_info(tmp_path, capsys):
     import pytest
 
     import arlequin
-    from arlequin.cli import main
+    from arlequin.cli.main import main
 
     with pytest.raises(SystemExit) as exit_:
         main(["--version"])
@@ -127,7 +127,7 @@ def test_progress_bar_shows_in_a_terminal():
     # a terminal of 24 x 100 characters (a pty has none by default, and tqdm draws nothing)
     fcntl.ioctl(slave, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 100, 0, 0))
     proc = subprocess.Popen(
-        [sys.executable, "-m", "arlequin.cli", "taylor-bar", "--model", "mono",
+        [sys.executable, "-m", "arlequin.cli.main", "taylor-bar", "--model", "mono",
          "--elements-radial", "3", "--t-end", "3e-6"],
         stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=slave,
     )  # fmt: skip

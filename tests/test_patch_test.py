@@ -15,8 +15,8 @@ import warnings
 
 import pytest
 
+from arlequin.coupling.gluing import ExactnessWarning
 from arlequin.demos.patch_test import run_patch_test
-from arlequin.gluing import ExactnessWarning
 
 EXACT_NESTED = [
     (dim, coupling, mediator, weights, seed)
@@ -73,7 +73,7 @@ def test_nonnested_hexahedra_are_a_clear_error():
     import numpy as np
     import skfem
 
-    from arlequin.overlap import OverlapError, build_overlap
+    from arlequin.coupling.overlap import OverlapError, build_overlap
 
     coarse = skfem.MeshHex.init_tensor(*(np.linspace(0, 1, 4),) * 3)
     fine = skfem.MeshHex.init_tensor(*(np.linspace(0.1, 0.8, 6),) * 3)

@@ -14,8 +14,8 @@ import pytest
 import skfem
 from _roundtrip import assert_mesh_round_trip
 
+from arlequin.geometry.meshcheck import MeshError
 from arlequin.io import UnsupportedMeshError, read_mesh
-from arlequin.meshcheck import MeshError
 
 FORMATS = ("vtu", "msh", "xdmf")
 

@@ -1,4 +1,5 @@
-"""Tests of arlequin.reference: first-order reference elements at per-point reference coordinates.
+"""Tests of arlequin.geometry.reference: first-order reference elements at per-point reference
+coordinates.
 
 Ground truth is scikit-fem itself (its element definitions ``lbasis``, its ``mesh.mapping().F``
 and its ``CellBasis`` gradients) and elementary facts of P1/Q1 elements (nodal basis, partition
@@ -13,7 +14,7 @@ import scipy.sparse as sp
 import skfem
 from _meshes import perturb
 
-from arlequin.reference import (
+from arlequin.geometry.reference import (
     evaluate_basis,
     interpolation_matrix,
     map_to_physical,

@@ -1,4 +1,5 @@
-"""Patch regions (arlequin/regions.py, arlequin/patches.py): closed surfaces, level sets, boxes.
+"""Patch regions (arlequin/geometry/regions.py, arlequin/coupling/patches.py): closed surfaces,
+level sets, boxes.
 
 Exact references: the inside of a box and of a sphere (the winding number is 1 inside, 0
 outside, to round-off away from the surface); the same region given as a surface (STL file),
@@ -14,9 +15,9 @@ import skfem
 import trimesh
 
 from arlequin import ArlequinProblem, Patch, solve_static
+from arlequin.coupling.patches import refine_region, select_cells
+from arlequin.geometry.regions import SurfaceRegion
 from arlequin.models import IsotropicElastic, LinearElastic
-from arlequin.patches import refine_region, select_cells
-from arlequin.regions import SurfaceRegion
 
 STEEL = IsotropicElastic(young=200e9, poisson=0.3, density=7800.0)
 

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from _roundtrip import assert_history_equal, assert_series_equal, load_results
 
-from arlequin.cli import main
+from arlequin.cli.main import main
 from arlequin.demos.patch_test import run_patch_test
 from arlequin.demos.two_bars import run_two_bars
 from arlequin.demos.wave import run_wave

@@ -16,9 +16,8 @@ import numpy as np
 import pytest
 import skfem
 
-from arlequin.cli import main
+from arlequin.cli.main import main
 from arlequin.demos.sliding_block import JSON_KEYS, run_sliding_block
-from arlequin.integrators import solve
 from arlequin.models import (
     ContactSurface,
     CoulombContact,
@@ -28,8 +27,9 @@ from arlequin.models import (
     PlaneObstacle,
     RigidContactPair,
 )
-from arlequin.models.friction import tangents
-from arlequin.system import Block, BlockTerm, CoupledSystem
+from arlequin.models.contact.friction import tangents
+from arlequin.problem.system import Block, BlockTerm, CoupledSystem
+from arlequin.solvers import solve
 
 MU = 0.3
 
@@ -192,7 +192,7 @@ def test_block_sliding_on_a_deformable_block():
     # stop time, 2.4 fixed-point iterations per step (max 5)
     import scipy.sparse as sp
 
-    from arlequin.system import LinearConstraint
+    from arlequin.problem.system import LinearConstraint
 
     young, nu, rho, h, w, n, p = 210e9, 0.3, 7850.0, 0.01, 0.02, 4, 1e5
     mat = IsotropicElastic(young, nu, rho)

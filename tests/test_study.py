@@ -8,22 +8,26 @@ import textwrap
 
 import pytest
 
-from arlequin.cli import main
+from arlequin.cli.main import main
 from arlequin.demos.study import StudyError, comparable, load_spec, run_case, study
 
-TWO_BARS = {"demo": "two-bars",
-            "parameters": {"velocity": [1.0, 2.0, 3.0, 4.0], "elements": [20, 40], "cfl": 1.0}}
+TWO_BARS = {
+    "demo": "two-bars",
+    "parameters": {"velocity": [1.0, 2.0, 3.0, 4.0], "elements": [20, 40], "cfl": 1.0},
+}
 
 
 def test_the_minimal_spec_has_the_cartesian_product(tmp_path):
     spec = tmp_path / "s.toml"
-    spec.write_text(textwrap.dedent("""
+    spec.write_text(
+        textwrap.dedent("""
         demo = "two-bars"            # a CLI demo name
         [parameters]
         velocity = [1.0, 2.0, 3.0]   # a list is a grid axis
         elements = [50, 100]
         cfl = 1.0                    # a scalar is fixed for every case
-    """))
+    """)
+    )
     parsed = load_spec(spec)
     assert len(parsed.cases) == 6
     assert parsed.cases[1].params == {"cfl": 1.0, "velocity": 1.0, "elements": 100}

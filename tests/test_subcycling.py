@@ -1,4 +1,4 @@
-"""The multi-time-step scheme (arlequin.integrators.subcycling) on a 1D Arlequin bar.
+"""The multi-time-step scheme (arlequin.solvers.subcycling) on a 1D Arlequin bar.
 
 The set-up: a coarse bar of 80 elements (1 m each) with a patch four times finer over its right
 half, glued over 10 m (H1, coarse mediator, ramp weights), a cos² pulse of 10 m in the coarse-only
@@ -17,13 +17,13 @@ import skfem
 
 from arlequin import ArlequinProblem, Patch
 from arlequin.contract import SimulationError
-from arlequin.integrators import (
+from arlequin.models import IsotropicElastic, LinearElastic
+from arlequin.solvers import (
     CentralDifference,
     SubcycledCentralDifference,
     solve,
     stable_time_step,
 )
-from arlequin.models import IsotropicElastic, LinearElastic
 
 YOUNG, DENSITY = 1.0e9, 1.0e3
 C = math.sqrt(YOUNG / DENSITY)
@@ -174,7 +174,7 @@ def test_bad_options(bar, options, match):
 
 
 def test_registered_names():
-    from arlequin.integrators import get_integrator
+    from arlequin.solvers import get_integrator
 
     for name in ("explicit-mts", "subcycling", "multi-time-step"):
         assert get_integrator(name) is SubcycledCentralDifference

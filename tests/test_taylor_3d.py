@@ -24,7 +24,7 @@ import numpy as np
 import pytest
 import skfem
 
-from arlequin.cli import main
+from arlequin.cli.main import main
 from arlequin.demos.taylor_bar import JSON_KEYS, TAYLOR_REFERENCE, run_taylor_bar
 from arlequin.demos.taylor_meshes_3d import (
     lateral_nodes,
@@ -32,8 +32,8 @@ from arlequin.demos.taylor_meshes_3d import (
     quarter_section_counts,
     refined_bar_mesh,
 )
+from arlequin.geometry.locate import locate_points
 from arlequin.io import read_series
-from arlequin.locate import locate_points
 
 L, R, V0, RHO = 32.4e-3, 3.2e-3, 227.0, 8930.0
 

@@ -19,7 +19,7 @@ import meshio  # noqa: F401  (the XDMF reader below needs it)
 import numpy as np
 import pytest
 
-from arlequin.cli import main
+from arlequin.cli.main import main
 from arlequin.demos.taylor_bar import (
     JSON_KEYS,
     TAYLOR_REFERENCE,

@@ -14,7 +14,7 @@ import meshio  # noqa: F401  (the XDMF reader below needs it)
 import numpy as np
 import pytest
 
-from arlequin.cli import main
+from arlequin.cli.main import main
 from arlequin.demos.taylor_bar import resume_taylor_bar, run_taylor_bar
 from arlequin.io import read_series
 
@@ -26,11 +26,13 @@ def _interrupt_at(t_stop: float):
     def progress(t: float) -> None:
         if t >= t_stop:
             raise KeyboardInterrupt  # what Ctrl-C does
+
     return progress
 
 
-@pytest.mark.parametrize(("model", "geometry"), [("arlequin", "axisymmetric"),
-                                                ("mono", "axisymmetric"), ("mono", "3d")])
+@pytest.mark.parametrize(
+    ("model", "geometry"), [("arlequin", "axisymmetric"), ("mono", "axisymmetric"), ("mono", "3d")]
+)
 def test_resumed_run_equals_the_uninterrupted_one(model, geometry, tmp_path):
     kw = {"model": model, "elements_radial": 4, "t_end": 8e-6, "checkpoint_interval": 2e-6,
           "geometry": geometry}  # fmt: skip
@@ -53,8 +55,11 @@ def test_resumed_run_equals_the_uninterrupted_one(model, geometry, tmp_path):
     for name in a["files"]["fields"]:
         fa = read_series(tmp_path / "whole" / "fields" / f"{name}.xdmf")[1]
         fb = read_series(tmp_path / "cut" / "fields" / f"{name}.xdmf")[1]
-        assert [f[0] for f in fa] == [f[0] for f in fb] == pytest.approx([0, 2e-6, 4e-6, 6e-6,
-                                                                         8e-6], abs=1e-15)
+        assert (
+            [f[0] for f in fa]
+            == [f[0] for f in fb]
+            == pytest.approx([0, 2e-6, 4e-6, 6e-6, 8e-6], abs=1e-15)
+        )
         for (_, pa, ca), (_, pb, cb) in zip(fa, fb):
             assert all(np.array_equal(pa[k], pb[k]) for k in pa)
             assert all(np.array_equal(ca[k][0], cb[k][0]) for k in ca)

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from skfem import MeshTet, MeshTri
 
-import arlequin.gluing as gluing
+import arlequin.coupling.gluing as gluing
 from arlequin import ArlequinProblem, Patch
 from arlequin.models import IsotropicElastic, LinearElastic
 

@@ -16,7 +16,7 @@ import json
 import numpy as np
 import pytest
 
-from arlequin.cli import main
+from arlequin.cli.main import main
 from arlequin.demos.block_impact import run_block_impact
 from arlequin.demos.two_bars import (
     JSON_KEYS,
@@ -218,8 +218,19 @@ def test_item8_3d_refinement(target):
 def test_json_keys_and_cli(tmp_path, capsys):
     path = tmp_path / "tb.json"
     png = tmp_path / "tb.png"
-    rc = main(["two-bars", "--method", "both", "--elements", "20", "--json", str(path),
-               "--plot", str(png)])
+    rc = main(
+        [
+            "two-bars",
+            "--method",
+            "both",
+            "--elements",
+            "20",
+            "--json",
+            str(path),
+            "--plot",
+            str(png),
+        ]
+    )
     assert rc == 0
     data = json.loads(path.read_text())
     assert list(data) == [*JSON_KEYS, "newmark"]

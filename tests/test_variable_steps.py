@@ -23,14 +23,6 @@ import skfem
 
 from arlequin.demos.cantilever import build_cantilever
 from arlequin.demos.two_bars import run_two_bars
-from arlequin.integrators import (
-    CentralDifference,
-    CriticalFraction,
-    StepSchedule,
-    ThetaScheme,
-    solve,
-    stable_time_step,
-)
 from arlequin.models import (
     ContactSurface,
     DeformableContactPair,
@@ -38,7 +30,15 @@ from arlequin.models import (
     LevelSetContact,
     LinearElastic,
 )
-from arlequin.system import Block, BlockTerm, CoupledSystem, LinearConstraint
+from arlequin.problem.system import Block, BlockTerm, CoupledSystem, LinearConstraint
+from arlequin.solvers import (
+    CentralDifference,
+    CriticalFraction,
+    StepSchedule,
+    ThetaScheme,
+    solve,
+    stable_time_step,
+)
 
 MODULATION = 0.46  # P Δt₀ / T₁
 
@@ -253,7 +253,7 @@ def test_one_controller_serves_several_integrators_and_a_model_alone_runs():
 def test_constraint_work_agrees_with_the_integrators(integrator):
     """A bar hitting a wall (velocity-level LinearInequality): the constraint's own work, from
     the step impulses, equals the integrator's constraint work (the same forces and motion)."""
-    from arlequin.integrators import LinearInequality
+    from arlequin.solvers import LinearInequality
 
     n = 20
     bar = LinearElastic(skfem.MeshLine(np.linspace(0.0, 1.0, n + 1)), IsotropicElastic(1.0, 0.0))
@@ -278,14 +278,14 @@ def test_verbose_runs_log_their_progress(monkeypatch, caplog):
     import numpy as np
     import skfem
 
-    from arlequin.integrators import driver, solve
     from arlequin.models import IsotropicElastic, LinearElastic
-    from arlequin.system import Block, BlockTerm, CoupledSystem
+    from arlequin.problem.system import Block, BlockTerm, CoupledSystem
+    from arlequin.solvers import driver, solve
 
     monkeypatch.setattr(driver, "LOG_INTERVAL", 0.0)
     bar = LinearElastic(skfem.MeshLine(np.linspace(0, 1, 11)), IsotropicElastic(1e9, 0.0, 1e3))
     system = CoupledSystem([Block("bar", bar, [BlockTerm(bar)])])
-    with caplog.at_level(logging.INFO, logger="arlequin.integrators.driver"):
+    with caplog.at_level(logging.INFO, logger="arlequin.solvers.driver"):
         solve(system, "explicit", n_steps=3, v0=np.ones(bar.n_dofs))
-    lines = [r.getMessage() for r in caplog.records if r.name == "arlequin.integrators.driver"]
+    lines = [r.getMessage() for r in caplog.records if r.name == "arlequin.solvers.driver"]
     assert len(lines) == 3 and lines[-1].startswith("step 3, t = ")

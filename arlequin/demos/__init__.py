@@ -9,5 +9,10 @@ re-exported here; the others live in their modules (``two_bars``, ``wave``, ``pa
 from .ball_impact import BallImpactResult, run_ball_impact
 from .taylor_bar import TaylorBarResult, resume_taylor_bar, run_taylor_bar
 
-__all__ = ["BallImpactResult", "TaylorBarResult", "resume_taylor_bar", "run_ball_impact",
-           "run_taylor_bar"]
+__all__ = [
+    "BallImpactResult",
+    "TaylorBarResult",
+    "resume_taylor_bar",
+    "run_ball_impact",
+    "run_taylor_bar",
+]

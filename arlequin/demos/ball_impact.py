@@ -52,9 +52,9 @@ from typing import Any
 
 import numpy as np
 
-from ..integrators import solve
 from ..io import DynamicRunWriter, ResultsFolder
 from ..models import IsotropicElastic, J2Material
+from ..solvers import solve
 from .ball_record import ImpactRecorder, write_outputs
 from .ball_result import INPUT_UNITS, JSON_KEYS, BallImpactResult, hertz
 from .ball_setup import ImpactBodies, ball_sizes
@@ -149,7 +149,7 @@ def run_ball_impact(
         The ball against the rigid plane z = 0 (no block).
     coarse_step_ratio : int, optional
         M > 1: the coarse models' forces once every m ≤ M steps, the largest m that keeps them
-        stable (``"explicit-mts"``, :class:`~arlequin.integrators.SubcycledCentralDifference`
+        stable (``"explicit-mts"``, :class:`~arlequin.solvers.SubcycledCentralDifference`
         with its resonance bound off and a 1% energy check), Arlequin only. 1: one step for
         every model. Default: :data:`DEFAULT_STEP_RATIO` (2) for ``arlequin``, 1 for the
         single-mesh models; larger ratios can resonate with the patches (the energy check
@@ -196,8 +196,11 @@ def run_ball_impact(
     if not (math.isfinite(friction) and friction >= 0.0):
         raise ValueError(f"friction must be a non-negative number, got friction={friction}")
     if coarse_step_ratio is not None and (
-            isinstance(coarse_step_ratio, bool) or not isinstance(coarse_step_ratio, (int, float))
-            or int(coarse_step_ratio) != coarse_step_ratio or coarse_step_ratio < 1):
+        isinstance(coarse_step_ratio, bool)
+        or not isinstance(coarse_step_ratio, (int, float))
+        or int(coarse_step_ratio) != coarse_step_ratio
+        or coarse_step_ratio < 1
+    ):
         raise ValueError(f"coarse_step_ratio must be a positive integer, got {coarse_step_ratio!r}")
     if coarse_step_ratio is not None and coarse_step_ratio > 1 and model != "arlequin":
         raise ValueError("coarse_step_ratio > 1 needs the arlequin model (coarse models)")
@@ -236,15 +239,21 @@ def run_ball_impact(
         # check stopped it at a balance error of 1.05%)
         coarse_step_ratio = DEFAULT_STEP_RATIO if model == "arlequin" else 1
     # the patches' cells, about: their half discs at the fine size (the block's too)
-    patch_cells = 0.5 * math.pi * (reach**2 + (0.0 if rigid_wall else block_reach**2)) \
-        / sizes.fine**2
+    patch_cells = (
+        0.5 * math.pi * (reach**2 + (0.0 if rigid_wall else block_reach**2)) / sizes.fine**2
+    )
     if patch_cells > PATCH_LIMIT:
         raise ValueError(f"the patches would hold about {patch_cells:.3g} cells at the fine size "
                          f"{sizes.fine:.4g} m (limit {PATCH_LIMIT:.3g}): a larger fine_size or "
                          "smaller patches")  # fmt: skip
     if abs(sizes.fine - fine) > 1e-9 * fine:
-        logger.info("fine size %.4g m rounded to %.4g m (coarse %.4g m / 2^%d)", fine,
-                    sizes.fine, sizes.coarse, sizes.levels)
+        logger.info(
+            "fine size %.4g m rounded to %.4g m (coarse %.4g m / 2^%d)",
+            fine,
+            sizes.fine,
+            sizes.coarse,
+            sizes.levels,
+        )
     if model in ("mono", "mono-zoned"):
         cells = _mono_cells(sizes, big, block_radius, block_height, rigid_wall)
         if cells > MONO_LIMIT:
@@ -269,10 +278,11 @@ def run_ball_impact(
                            "(%.4g m/s): Hertz's quasi-static solution is only a guide", velocity,
                            bar_speed)  # fmt: skip
         if not rigid_wall and block_size < 10.0 * big:
-            logger.warning("a block under 10 ball radii (%.4g m) is not the half-space of "
-                           "Hertz's solution", block_size)
+            logger.warning(
+                "a block under 10 ball radii (%.4g m) is not the half-space of Hertz's solution",
+                block_size,
+            )
     return _run(config, sizes, ball_material, block_material, out, progress)
-
 
 
 def _run(config, sizes, ball_material, block_material, out, progress) -> BallImpactResult:

@@ -27,10 +27,16 @@ from __future__ import annotations
 import numpy as np
 import skfem
 
-from ..patches import refine_region
+from ..coupling.patches import refine_region
 
-__all__ = ["ball_patch_mesh", "block_mesh", "block_patch_mesh", "graded_coordinates",
-           "half_disk_mesh", "snap_to_sphere"]
+__all__ = [
+    "ball_patch_mesh",
+    "block_mesh",
+    "block_patch_mesh",
+    "graded_coordinates",
+    "half_disk_mesh",
+    "snap_to_sphere",
+]
 
 #: Growth ratio of the coarse block's cells away from the contact point.
 GROWTH = 1.15

@@ -12,8 +12,15 @@ from typing import Any
 from ..io import JsonResult
 from ..models import IsotropicElastic
 
-__all__ = ["HISTORY_KEYS", "HISTORY_UNITS", "INPUT_UNITS", "JSON_KEYS", "RESULT_UNITS",
-           "BallImpactResult", "hertz"]
+__all__ = [
+    "HISTORY_KEYS",
+    "HISTORY_UNITS",
+    "INPUT_UNITS",
+    "JSON_KEYS",
+    "RESULT_UNITS",
+    "BallImpactResult",
+    "hertz",
+]
 
 #: The Interface's keys, in order (then the Hertz values and the inputs).
 JSON_KEYS = ("contact_duration", "peak_force", "restitution", "dent_depth",
@@ -38,6 +45,7 @@ RESULT_UNITS = {"contact_duration": "s", "peak_force": "N", "restitution": "1",
                 "coarse_size": "m", "n_steps": "1", "contact_radius_cells": "1",
                 "band_max_plastic_strain": "1", "t_end": "s",
                 "mean_step_ratio": "1"}  # fmt: skip
+
 
 def hertz(radius: float, mass: float, velocity: float, ball: IsotropicElastic,
           block: IsotropicElastic | None) -> dict[str, float]:  # fmt: skip

@@ -24,7 +24,6 @@ from typing import Any
 
 import numpy as np
 
-from ..bodies import MultiBodyProblem
 from ..models import (
     ContactSurface,
     CoulombContact,
@@ -37,7 +36,8 @@ from ..models import (
     PlaneObstacle,
     RigidContactPair,
 )
-from ..problem import ArlequinProblem, Patch
+from ..problem.arlequin_problem import ArlequinProblem, Patch
+from ..problem.bodies import MultiBodyProblem
 from .ball_meshes import GROWTH, ball_patch_mesh, block_mesh, block_patch_mesh, half_disk_mesh
 from .ball_zoned import ZonedBody
 

@@ -17,8 +17,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..models import FiniteStrainJ2, J2Material, LinearElastic
-from ..problem import ArlequinProblem
-from ..system import Block, BlockTerm, CoupledSystem
+from ..problem.arlequin_problem import ArlequinProblem
+from ..problem.system import Block, BlockTerm, CoupledSystem
 
 __all__ = ["FrozenLinear", "ZonedBody"]
 

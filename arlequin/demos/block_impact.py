@@ -14,7 +14,6 @@ from dataclasses import dataclass
 import numpy as np
 import skfem
 
-from ..integrators import solve
 from ..io import JsonResult
 from ..models import (
     ContactSurface,
@@ -25,7 +24,8 @@ from ..models import (
     PlaneObstacle,
     RigidContactPair,
 )
-from ..system import Block, BlockTerm, CoupledSystem
+from ..problem.system import Block, BlockTerm, CoupledSystem
+from ..solvers import solve
 
 __all__ = ["BlockImpactResult", "run_block_impact"]
 

@@ -19,9 +19,9 @@ from dataclasses import dataclass
 import numpy as np
 import skfem
 
-from ..integrators import solve_static
 from ..models import IsotropicElastic, LinearElastic
-from ..problem import ArlequinProblem, Patch
+from ..problem.arlequin_problem import ArlequinProblem, Patch
+from ..solvers import solve_static
 
 __all__ = ["Cantilever", "build_cantilever", "tri_grid"]
 
@@ -93,7 +93,7 @@ def build_cantilever(
     length, height, patch_length, gluing_width : float
         Beam length and height, patch length a and gluing band width (m).
     weights, coupling, mediator : str
-        See :class:`arlequin.problem.Patch`.
+        See :class:`arlequin.problem.arlequin_problem.Patch`.
     jitter : float
         Random displacement of the patch's interior nodes, as a fraction of its spacing.
     initial_state : bool

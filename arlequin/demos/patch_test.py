@@ -26,10 +26,10 @@ from typing import Any
 import numpy as np
 import skfem
 
-from ..integrators.static import solve_static
+from ..coupling.patches import refine_region
 from ..io import JsonResult, ResultsFolder, write_static
-from ..patches import refine_region
-from ..problem import ArlequinProblem, Patch
+from ..problem.arlequin_problem import ArlequinProblem, Patch
+from ..solvers.static import solve_static
 
 __all__ = ["PatchTestResult", "build_patch_test_problem", "run_patch_test"]
 

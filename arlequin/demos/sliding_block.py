@@ -51,7 +51,6 @@ from typing import Any
 import numpy as np
 import skfem
 
-from ..integrators import RayleighDamping, SmoothStep, solve
 from ..io import DynamicRunWriter, JsonResult, ResultsFolder
 from ..models import (
     ContactSurface,
@@ -62,7 +61,8 @@ from ..models import (
     PlaneObstacle,
     RigidContactPair,
 )
-from ..system import Block, BlockTerm, CoupledSystem
+from ..problem.system import Block, BlockTerm, CoupledSystem
+from ..solvers import RayleighDamping, SmoothStep, solve
 
 __all__ = ["DAMPING", "JSON_KEYS", "RAMP_TRANSITS", "SlidingBlockResult", "run_sliding_block"]
 
@@ -174,8 +174,14 @@ class SlidingBlockResult(JsonResult):
         """The Interface's keys first (histories decimated to ≤ 2000 points), then the rest."""
         data = super().to_json()
         step = max(1, math.ceil(len(self.t) / 2000))
-        for k in ("t", "mean_velocity", "friction_work", "contact_work", "total_energy",
-                  "damping_work"):
+        for k in (
+            "t",
+            "mean_velocity",
+            "friction_work",
+            "contact_work",
+            "total_energy",
+            "damping_work",
+        ):
             data[k] = data[k][::step]
         config = data.pop("config")
         ordered = {k: data.pop(k) for k in JSON_KEYS}

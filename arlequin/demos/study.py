@@ -101,7 +101,7 @@ def run_case(demo: str, params: Mapping[str, Any], out: str | os.PathLike,
     import contextlib
     import io
 
-    from ..cli_demos import demo_parser
+    from ..cli.demos import demo_parser
 
     parser, commands = demo_parser()
     argv = _argv(demo, params, commands[demo])

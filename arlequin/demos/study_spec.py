@@ -56,7 +56,7 @@ class StudySpec:
 
 
 def _subparser(demo: str):
-    from ..cli_demos import demo_parser
+    from ..cli.demos import demo_parser
 
     return demo_parser()[1][demo]
 
@@ -103,8 +103,10 @@ def _check_case(demo: str, params: Mapping[str, Any], parser) -> None:
             raise StudyError(f"parameter {key!r} of {demo!r} takes {kind}, got {value!r}")
         if isinstance(value, bool):
             continue
-        if isinstance(action.nargs, int) and action.nargs > 1 and not (
-            isinstance(value, (list, tuple)) and len(value) == action.nargs
+        if (
+            isinstance(action.nargs, int)
+            and action.nargs > 1
+            and not (isinstance(value, (list, tuple)) and len(value) == action.nargs)
         ):
             raise StudyError(f"parameter {key!r} of {demo!r} takes {action.nargs} values "
                              f"(a list of {action.nargs}), got {value!r}")  # fmt: skip
@@ -126,7 +128,7 @@ def _check_case(demo: str, params: Mapping[str, Any], parser) -> None:
 
 def _check_ranges(demo: str, params: Mapping[str, Any], parser) -> None:
     """The demo's own input checks on the case's parsed command line (before any case runs)."""
-    from ..cli_demos import check_case
+    from ..cli.demos import check_case
 
     args = parser.parse_args(_argv(demo, params, parser)[1:])
     try:
@@ -159,7 +161,7 @@ def load_spec(spec: str | os.PathLike | Mapping[str, Any]) -> StudySpec:
         raise StudyError(f"unknown keys {unknown} in the study (keys: demo, parameters, cases)")
     demo = data.get("demo")
     if not isinstance(demo, str):
-        raise StudyError(f"the study needs demo = \"<name>\" (one of {list(DEMOS)}), got {demo!r}")
+        raise StudyError(f'the study needs demo = "<name>" (one of {list(DEMOS)}), got {demo!r}')
     params = dict(data.get("parameters", {}))
     if not isinstance(params, dict):
         raise StudyError("[parameters] must be a table of option = value or [values]")
@@ -181,7 +183,7 @@ def load_spec(spec: str | os.PathLike | Mapping[str, Any]) -> StudySpec:
     if ":" in demo:
         _resolve(demo)  # importable
     elif demo not in DEMOS:
-        raise StudyError(f"demo {demo!r} is not one of {list(DEMOS)} (or \"module:function\")")
+        raise StudyError(f'demo {demo!r} is not one of {list(DEMOS)} (or "module:function")')
     else:
         parser = _subparser(demo)
         for case in cases:
@@ -204,5 +206,3 @@ def _resolve(target: str) -> Callable[..., Mapping[str, Any]]:
         return getattr(importlib.import_module(module), name)
     except (ImportError, AttributeError) as exc:
         raise StudyError(f"demo {target!r}: cannot import {name!r} from {module!r}: {exc}") from exc
-
-

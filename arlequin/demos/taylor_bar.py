@@ -10,7 +10,7 @@ conforming finite-strain mesh, fine over the patch region and coarse above. The 
 level-set contact model on the impact face and the lower lateral surface (which folds onto the
 wall as the mushroom forms), lift-off allowed; the axis carries u_r = 0. Central differences
 with the step re-estimated from the current configuration every few steps
-(:class:`~arlequin.integrators.CriticalFraction`).
+(:class:`~arlequin.solvers.CriticalFraction`).
 
 Energy balance, at every record: KE + W_el + D_p + D_visc + W_c = KE_0 with KE the explicit
 scheme's kinetic energy ½ṽ^{n−½}·M v^{n+½}, W_el the stored (Hencky) energy, D_p and D_visc the
@@ -42,10 +42,10 @@ from typing import Any
 
 import numpy as np
 
-from ..integrators import CriticalFraction, solve
+from ..coupling.weights import PartitionWeights
 from ..io import ResultsFolder
 from ..models import BulkViscosity, J2Material
-from ..weights import PartitionWeights
+from ..solvers import CriticalFraction, solve
 from .taylor_checkpoint import CheckpointWriter, load_checkpoint, read_frames
 from .taylor_meshes import (
     elements_radial_of,
@@ -197,7 +197,7 @@ def run_taylor_bar(
         ``arlequin`` only: the largest number M of patch (fine) steps per coarse step (default 1,
         one step for the coupled system). With M > 1 the coarse model's internal force is
         applied once every m ≤ M fine steps
-        (:class:`~arlequin.integrators.SubcycledCentralDifference`, m the largest ratio keeping
+        (:class:`~arlequin.solvers.SubcycledCentralDifference`, m the largest ratio keeping
         the coarse model within its own stable step; without its resonance bound, the run
         stopped with a :class:`~arlequin.contract.SimulationError` if the energy balance
         error passes 1%).
@@ -275,7 +275,8 @@ def run_taylor_bar(
     arlequin = model == "arlequin"
     # the patch's sizes apply (3D mono with coarse_size: the coarse O-grid refined)
     nested = model in ("arlequin", "graded") or (
-        model == "mono" and geometry == "3d" and coarse_size is not None)
+        model == "mono" and geometry == "3d" and coarse_size is not None
+    )
     if not nested:
         extra = {k: v for k, v in (("patch_length", patch_length), ("coarse_size", coarse_size))
                  if v is not None}  # fmt: skip
@@ -311,8 +312,9 @@ def run_taylor_bar(
                                  ("coupling", coupling, ("L2", "H1"))):  # fmt: skip
         if value not in choices:
             raise ValueError(f"{name} must be one of {choices}, got {name}={value!r}")
-    if isinstance(friction, bool) or not (isinstance(friction, (int, float))
-                                          and math.isfinite(friction) and friction >= 0.0):
+    if isinstance(friction, bool) or not (
+        isinstance(friction, (int, float)) and math.isfinite(friction) and friction >= 0.0
+    ):
         raise ValueError(f"friction must be a non-negative number (Coulomb μ), got {friction!r}")
     if not (isinstance(band_warning, (int, float)) and band_warning >= 0.0):
         raise ValueError(f"band_warning must be a non-negative number, got {band_warning!r}")
@@ -355,8 +357,8 @@ def run_taylor_bar(
     if visc:
         config.update(bulk_viscosity_linear=visc.linear, bulk_viscosity_quadratic=visc.quadratic)
     if fine_model.backend == "numba":
-        from ..models.j2_kernel import warm_up
-        from ..models.j2_kernel_3d import warm_up_solid
+        from ..models.plasticity.j2_kernel import warm_up
+        from ..models.plasticity.j2_kernel_3d import warm_up_solid
 
         # compile (or load) before the clock starts
         warm_up_solid() if geometry == "3d" else warm_up()
@@ -394,11 +396,20 @@ def run_taylor_bar(
         on_step = [rec.count_step] + ([lam_history] if lam_history is not None else [])
         if mts:
             on_step.append(lambda integ: mts_seen.__setitem__("integ", integ))
-        res = solve(bar.system, "explicit-mts" if mts else "explicit", t_end=t_end, v0=v0,
-                    constraints=[con], **mts,
-                    step_controller=controller, t_eval=t_eval, on_record=[rec],
-                    on_step=on_step, on_checkpoint=saver,
-                    restore=None if ckpt is None else (ckpt["snapshot"], ckpt["recorder"]))
+        res = solve(
+            bar.system,
+            "explicit-mts" if mts else "explicit",
+            t_end=t_end,
+            v0=v0,
+            constraints=[con],
+            **mts,
+            step_controller=controller,
+            t_eval=t_eval,
+            on_record=[rec],
+            on_step=on_step,
+            on_checkpoint=saver,
+            restore=None if ckpt is None else (ckpt["snapshot"], ckpt["recorder"]),
+        )
     except Exception as exc:
         if folder is not None:
             folder.finish("failed", str(exc))

@@ -31,7 +31,7 @@ _FORMAT = 1
 
 
 class CheckpointWriter:
-    """The ``on_checkpoint`` listener of :func:`arlequin.integrators.solve` for a Taylor run.
+    """The ``on_checkpoint`` listener of :func:`arlequin.solvers.solve` for a Taylor run.
 
     Parameters
     ----------

@@ -37,7 +37,6 @@ def taylor_bar_mesh(length: float, radius: float, elements_radial: int) -> skfem
                                       np.linspace(0.0, length, n_z + 1))  # fmt: skip
 
 
-
 class ArlequinBarSizes:
     """The nested meshes of :class:`ArlequinBar`, snapped to coarse cell edges (SI units).
 
@@ -162,13 +161,24 @@ def arlequin_bar_sizes(
     return ArlequinBarSizes(n_rc, n_zc, k, rows, band, length, radius)
 
 
-
-
 #: The 2:1 template on the unit [0, 4] × [0, 1] (fine edges of length 1 below, coarse of length
 #: 2 above): node coordinates and six counterclockwise quadrilaterals.
-_TEMPLATE_NODES = np.array([[0, 0], [1, 0], [2, 0], [3, 0], [4, 0],      # b0..b4
-                            [1, 0.5], [2, 0.5], [3, 0.5],                # m1, c, m3
-                            [0, 1], [2, 1], [4, 1]], dtype=float).T      # t0, t2, t4
+_TEMPLATE_NODES = np.array(
+    [
+        [0, 0],
+        [1, 0],
+        [2, 0],
+        [3, 0],
+        [4, 0],  # b0..b4
+        [1, 0.5],
+        [2, 0.5],
+        [3, 0.5],  # m1, c, m3
+        [0, 1],
+        [2, 1],
+        [4, 1],
+    ],
+    dtype=float,
+).T  # t0, t2, t4
 _TEMPLATE_QUADS = np.array([[0, 1, 5, 8], [1, 2, 6, 5], [5, 6, 9, 8],
                             [2, 3, 7, 6], [3, 4, 10, 7], [6, 7, 10, 9]]).T  # fmt: skip
 

@@ -46,8 +46,8 @@ from ..models import (
     RigidContactPair,
     make_hardening,
 )
-from ..problem import ArlequinProblem, Patch
-from ..system import Block, BlockTerm, CoupledSystem, LinearConstraint
+from ..problem.arlequin_problem import ArlequinProblem, Patch
+from ..problem.system import Block, BlockTerm, CoupledSystem, LinearConstraint
 from .taylor_meshes import ArlequinBarSizes, taylor_bar_mesh
 
 __all__ = ["LAW_DEFAULTS", "ArlequinBar", "ArlequinBarView", "MonoBar", "hardening_parameters"]
@@ -64,6 +64,7 @@ LAW_DEFAULTS: dict[str, dict[str, float]] = {
     "voce": {"voce_saturation": 0.1e9, "voce_rate": 10.0},
     "johnson-cook": {"jc_b": 0.292e9, "jc_n": 0.31, "jc_c": 0.0, "jc_reference_rate": 1.0},
 }
+
 
 def hardening_parameters(law: str, yield_stress: float, hardening: float, **params: float):
     """The :class:`~arlequin.models.Hardening` of a law name and the CLI's parameters.
@@ -246,7 +247,6 @@ class ArlequinBarView:
     def band_plastic_strain(self, state) -> float:
         """Largest ε̄p at the quadrature points of the gluing band's fine cells."""
         return float(np.asarray(state.eqps)[self.band_cells].max())
-
 
 
 class ArlequinBar(ArlequinBarView):

@@ -23,6 +23,7 @@ import numpy as np
 import scipy.sparse as sp
 import skfem
 
+from ..coupling.patches import Patch, select_cells
 from ..models import (
     ContactSurface,
     CoulombContact,
@@ -33,9 +34,8 @@ from ..models import (
     PlaneObstacle,
     RigidContactPair,
 )
-from ..patches import Patch, select_cells
-from ..problem import ArlequinProblem
-from ..system import Block, BlockTerm, CoupledSystem, LinearConstraint
+from ..problem.arlequin_problem import ArlequinProblem
+from ..problem.system import Block, BlockTerm, CoupledSystem, LinearConstraint
 from .taylor_meshes import ArlequinBarSizes
 from .taylor_meshes_3d import patch_levels, quarter_bar_mesh, refined_bar_mesh
 from .taylor_models import LATERAL_CONTACT, ArlequinBarView
@@ -156,8 +156,15 @@ class MonoBar3D(_Quarter):
         self.system = CoupledSystem([Block("bar", bar, [BlockTerm(bar)])],
                                     [LinearConstraint(rows, None, name="symmetry",
                                                       kind="dirichlet")])  # fmt: skip
-        self.contact = _wall(mesh, self.system.dofmap["bar"], self.system.dofmap,
-                             material.elastic, radius, LATERAL_CONTACT * length, friction)
+        self.contact = _wall(
+            mesh,
+            self.system.dofmap["bar"],
+            self.system.dofmap,
+            material.elastic,
+            radius,
+            LATERAL_CONTACT * length,
+            friction,
+        )
         self._locate(mesh, mesh, length)
         self.n_elements = int(mesh.nelements)
         #: layers along z

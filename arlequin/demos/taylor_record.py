@@ -66,10 +66,16 @@ class TaylorRecorder:
         self.history: dict[str, list[float]] = {k: [] for k in self.units}
         self.balance: list[float] = []
         self.iterations: dict[int, int] = {}  # contact fixed-point iterations -> steps
-        self.csv = folder.history([*self.units, "balance_error"],
-                                  {**self.units, "balance_error": "1"}) if folder else None
-        self.series = ({name: folder.series(name, mesh)
-                        for name, mesh in bar.series_meshes().items()} if folder else {})
+        self.csv = (
+            folder.history([*self.units, "balance_error"], {**self.units, "balance_error": "1"})
+            if folder
+            else None
+        )
+        self.series = (
+            {name: folder.series(name, mesh) for name, mesh in bar.series_meshes().items()}
+            if folder
+            else {}
+        )
         self.frame_times = np.asarray(frame_times) if folder else np.zeros(0)
         self._next_frame = 0
         self.progress = progress
@@ -130,7 +136,6 @@ class TaylorRecorder:
         if self.progress is not None:
             self.progress(float(integ.t))
 
-
     def count_step(self, integ) -> None:
         """An ``on_step`` listener: the distribution of the contact fixed-point iterations."""
         k = int(integ.status_iterations)
@@ -142,8 +147,11 @@ class TaylorRecorder:
         if not steps:
             return {"mean": 0.0, "max": 0, "counts": {}}
         mean = sum(k * n for k, n in self.iterations.items()) / steps
-        return {"mean": mean, "max": max(self.iterations),
-                "counts": {k: self.iterations[k] for k in sorted(self.iterations)}}
+        return {
+            "mean": mean,
+            "max": max(self.iterations),
+            "counts": {k: self.iterations[k] for k in sorted(self.iterations)},
+        }
 
     def state(self) -> dict[str, Any]:
         """What the run has recorded so far (a checkpoint; see :meth:`restore`)."""
@@ -221,9 +229,18 @@ def write_results(folder: ResultsFolder, result: Any, units: dict[str, str]) -> 
     values = {k: v for k, v in result.to_json().items()
               if k not in ("history", "config", "reference")}  # fmt: skip
     hist = result.history
-    values["final_energies"] = {k: hist[k][-1] for k in ("kinetic", "elastic",
-                                "plastic_dissipation", "viscous_dissipation", "coupling_work",
-                                "contact_work") if k in hist}
+    values["final_energies"] = {
+        k: hist[k][-1]
+        for k in (
+            "kinetic",
+            "elastic",
+            "plastic_dissipation",
+            "viscous_dissipation",
+            "coupling_work",
+            "contact_work",
+        )
+        if k in hist
+    }
     folder.add_results(values, units)
     plot_taylor_bar(result, str(folder.picture("taylor_bar_history")))
     title = (f"t = {result.history['t'][-1] * 1e6:.1f} us: length {result.final_length * 1e3:.2f} "

@@ -52,6 +52,7 @@ class GluingBandPlasticityWarning(UserWarning):
 #: Published converged values at 80 µs (3D, 1.5M elements), m.
 TAYLOR_REFERENCE = {"final_length": 21.43e-3, "mushroom_radius": 7.23e-3}
 
+
 @dataclass
 class TaylorBarResult(JsonResult):
     """One Taylor bar run (SI units).

@@ -45,8 +45,10 @@ def build_bar(
         raise ValueError(f"patch_surface applies to model='arlequin' with geometry='3d' only, "
                          f"got model={model!r}, geometry={geometry!r}")  # fmt: skip
     if patch_surface is not None and patch_length is not None:
-        raise ValueError(f"give patch_length or patch_surface, not both (got "
-                         f"patch_length={patch_length}, patch_surface={patch_surface!r})")
+        raise ValueError(
+            f"give patch_length or patch_surface, not both (got "
+            f"patch_length={patch_length}, patch_surface={patch_surface!r})"
+        )
     if three_d and model == "mono" and patch_length is not None:
         raise ValueError(f"patch_length applies to model='arlequin' only, got model={model!r}")
     sizes = None

@@ -29,7 +29,6 @@ from typing import Any
 import numpy as np
 import skfem
 
-from ..integrators import solve
 from ..io import DynamicRunWriter, ResultsFolder
 from ..models import (
     ContactSurface,
@@ -41,7 +40,8 @@ from ..models import (
     RigidContactPair,
     SignoriniContact,
 )
-from ..system import Block, BlockTerm, CoupledSystem
+from ..problem.system import Block, BlockTerm, CoupledSystem
+from ..solvers import solve
 from .impact import JSON_KEYS, TwoBarsResult, exact_two_bars, impact_metrics
 from .plots import plot_two_bars
 

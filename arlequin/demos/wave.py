@@ -37,7 +37,11 @@ from typing import Any
 import numpy as np
 import skfem
 
-from ..integrators import (
+from ..io import DynamicRunWriter, JsonResult, ResultsFolder
+from ..models import IsotropicElastic, LinearElastic
+from ..problem.arlequin_problem import ArlequinProblem, Patch
+from ..problem.system import Block, BlockTerm, CoupledSystem
+from ..solvers import (
     DEFAULT_SAFETY,
     CentralDifference,
     check_time_step,
@@ -45,11 +49,7 @@ from ..integrators import (
     solve,
     stable_time_step,
 )
-from ..integrators.controllers import check_step
-from ..io import DynamicRunWriter, JsonResult, ResultsFolder
-from ..models import IsotropicElastic, LinearElastic
-from ..problem import ArlequinProblem, Patch
-from ..system import Block, BlockTerm, CoupledSystem
+from ..solvers.controllers import check_step
 from .plots import plot_wave
 
 __all__ = ["INTEGRATORS", "WaveResult", "plot_wave", "run_wave", "wave_layout"]
@@ -192,7 +192,7 @@ def run_wave(
         Results folder to write (:class:`arlequin.io.ResultsFolder`): results.json,
         history.csv of the coupled run (energies and works per model, every step), its field
         series (51 frames: displacement, velocity, alpha, the multiplier field) and wave.png.
-        The result then keeps the coupled run's :class:`~arlequin.integrators.DynamicResult`
+        The result then keeps the coupled run's :class:`~arlequin.solvers.DynamicResult`
         with its fields (``result.dynamic``).
     progress : callable, optional
         ``progress(fraction)`` with the fraction of the coupled run's steps done, about 200

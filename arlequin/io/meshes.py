@@ -6,8 +6,9 @@ support (:data:`SUPPORTED`: first-order triangles, quadrilaterals, tetrahedra, h
 Lower-dimensional cells only name boundaries (Gmsh physical groups become the mesh's
 ``boundaries``, cell sets of the main type its ``subdomains``: scikit-fem's ``from_meshio``).
 Nodes no cell uses (Gmsh's geometry points) are dropped. The mesh is then checked
-(:func:`arlequin.meshcheck.check_mesh`: inverted or degenerate cells, non-finite coordinates).
-Coordinates are multiplied by ``scale`` to give metres (1e-3 for a file in millimetres).
+(:func:`arlequin.geometry.meshcheck.check_mesh`: inverted or degenerate cells, non-finite
+coordinates). Coordinates are multiplied by ``scale`` to give metres (1e-3 for a file in
+millimetres).
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ import numpy as np
 import skfem
 from skfem.io.meshio import from_meshio
 
-from ..meshcheck import MeshError, check_mesh
+from ..geometry.meshcheck import MeshError, check_mesh
 
 __all__ = ["SUPPORTED", "UnsupportedMeshError", "read_mesh"]
 
@@ -80,8 +81,10 @@ def read_mesh(source: Any, scale: float = 1.0) -> skfem.Mesh:
         try:
             source = meshio.read(os.fspath(source))
         except SystemExit as exc:  # meshio exits on a file no reader accepts
-            raise MeshError(f"{name}: meshio could not read it (not a mesh, or a format it "
-                            "guesses wrongly from the extension)") from exc
+            raise MeshError(
+                f"{name}: meshio could not read it (not a mesh, or a format it "
+                "guesses wrongly from the extension)"
+            ) from exc
         except Exception as exc:
             raise MeshError(f"{name}: meshio could not read it: {exc}") from exc
     types = sorted({block.type for block in source.cells if len(block.data)})

@@ -1,6 +1,6 @@
 """Writers of runs into a results folder: dynamic runs as they go, static solutions at once.
 
-:class:`DynamicRunWriter` is a listener for :func:`arlequin.integrators.solve` (``on_record``):
+:class:`DynamicRunWriter` is a listener for :func:`arlequin.solvers.solve` (``on_record``):
 at every record it appends a history row (time, step, energies and works per block, the energy
 balance) and, at the frame times, a frame of every block's field series.
 """
@@ -34,7 +34,7 @@ class DynamicRunWriter:
     frame_times : sequence of float, optional
         Times (s) of the field frames: a frame is written at the first record at or after each
         (default: every record). To have the frames exactly at these times, give them to
-        :func:`~arlequin.integrators.solve` as ``t_eval`` too (the records are then only there).
+        :func:`~arlequin.solvers.solve` as ``t_eval`` too (the records are then only there).
     prefix : str
         Prefix of the file names (several runs in one folder).
     """

@@ -1,0 +1,483 @@
+"""Explicit central differences with lumped weighted masses and velocity-level constraint impulses.
+
+Variable steps (Δt_n from t_n to t_{n+1}, Δt̄_n = ½(Δt_{n−1} + Δt_n), Δt_{−1} = 0), lumped
+α-weighted mass M (diagonal):
+
+1. free prediction ``v* = v^{n−1/2} + Δt̄_n M⁻¹ (f_ext(t_n) − f_int(u^n))`` (v^{−1/2} = v^0:
+   the first step is the usual half step);
+2. impulses Λ (N·s) that make the corrected velocity ``v^{n+1/2} = v* − M⁻¹ Bᵀ Λ`` satisfy every
+   equality row at velocity level:
+
+   * displacement rows ``B u = g``: ``B v^{n+1/2} = (g(t_{n+1}) − B u^n)/Δt_n`` (the end-of-step
+     displacement satisfies the row exactly: no drift);
+   * velocity rows ``B v = g``: ``B v^{n+1/2} = g(t_{n+1/2})``;
+
+   i.e. ``(B M⁻¹ Bᵀ) Λ = B v* − w``. For the Arlequin rows ``[C_c, −C_f]`` the matrix is
+   ``C_c M_c⁻¹ C_cᵀ + C_f M_f⁻¹ C_fᵀ``; the masses being constant (total Lagrangian), it is
+   factorised once. Active unilateral rows (contact) are added by a Schur complement on that
+   factorisation, and the step's solve is repeated until their statuses settle;
+3. ``u^{n+1} = u^n + Δt_n v^{n+1/2}``.
+
+This is velocity Verlet with the steps Δt_n, second order for any step sequence. Multipliers are
+reported as forces λ^n = Λ^n/Δt̄_n at t_n (force on the system −Bᵀλ). The full-step velocity
+splits the kick at t_n in proportion to the two half steps,
+``v^n = v^{n−1/2} + Δt_{n−1}/(Δt_{n−1} + Δt_n) (v^{n+1/2} − v^{n−1/2})`` (the mean of the two
+mid-step velocities for a constant step; for time-independent rows it is projected on the rows),
+so the impulse at t_n is computed at the end of step n−1 with the step Δt_n chosen then, and
+everything at t_n (u, v, a, λ, energies) is known after each call of
+:meth:`CentralDifference.step`; imposing another Δt_n (``step(dt)``, ``set_step_size``) redoes
+that impulse. Works are accumulated by the trapezoidal rule on the powers at t_n and t_{n+1}:
+external ``f·v``, constraint ``−λ·B v``.
+
+With linear models a step is one sparse mat-vec with the assembled stiffness, a few vector
+operations, two small sparse products with the rows restricted to the dofs they touch, and one
+triangular solve pair.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..contract import SimulationError, capabilities
+from .base import Integrator
+from .controllers import FixedStep, StepController
+from .damping import RayleighDamping
+from .impulses import ImpulseSolver
+from .registry import register
+from .row_basis import ImpulseBasis
+from .rows import EqualityRows, transposed, unilateral_block_powers
+from .stability import DEFAULT_SAFETY, StableStep, check_time_step, stable_time_step
+
+__all__ = ["DEFAULT_SAFETY", "CentralDifference"]
+
+logger = logging.getLogger(__name__)
+
+
+@register("explicit", "central_difference", "central-difference")
+class CentralDifference(Integrator):
+    """Explicit central differences, lumped α-weighted masses, velocity-level constraint impulses.
+
+    Parameters
+    ----------
+    system : CoupledSystem
+    dt : float, optional
+        Time step (s). Default: ``safety`` × the critical step of the coupled system. A step above
+        the computed critical step is refused with a ``ValueError`` giving both numbers.
+    safety : float
+        Ratio of the default step to the critical step (default 0.9).
+    stable_method : {"coupled", "blocks", "gershgorin"}
+        Estimate of the critical step (see :mod:`arlequin.solvers.stability`).
+    check_dt : bool
+        Refuse a step above the critical one (default True).
+    damping : RayleighDamping, optional
+        Rayleigh damping C = α M + β K₀ (:mod:`arlequin.solvers.damping`): the force
+        −C v^{n−1/2} at t_n, the critical step reduced accordingly, the dissipated energy in
+        ``energies()["damping_work"]``. Default none.
+    **kwargs
+        See :class:`arlequin.solvers.base.Integrator` (``step_controller`` among them: e.g.
+        :class:`~arlequin.solvers.CriticalFraction` to follow a changing configuration).
+
+    Attributes
+    ----------
+    stable_step : StableStep
+        The critical-step estimates at the initial configuration.
+    constraint_time : float
+        Wall time (s) spent in the constraint impulses (transfers B v, Bᵀ Λ and the solves).
+    """
+
+    name = "explicit"
+    lumped_default = True
+    applies_multipliers = True
+    # its dense products are a few contact rows: a BLAS pool would spin on the kernels' cores
+    blas_threads = 1
+
+    def __init__(
+        self,
+        system,
+        dt: float | None = None,
+        *,
+        safety: float = DEFAULT_SAFETY,
+        stable_method: str = "coupled",
+        check_dt: bool = True,
+        damping: RayleighDamping | None = None,
+        **kwargs: Any,
+    ) -> None:
+        if damping is not None and not isinstance(damping, RayleighDamping):
+            raise TypeError(f"damping must be a RayleighDamping or None, got "
+                            f"{type(damping).__name__}")  # fmt: skip
+        self.damping = damping if damping is not None and damping.active else None
+        self._c_matrix: sp.csr_matrix | None = None
+        self._f_damp: np.ndarray | None = None
+        if not 0.0 < safety <= 1.0:
+            raise ValueError(f"safety factor must lie in (0, 1], got safety={safety}")
+        if kwargs.get("lumped") is False:
+            raise ValueError("the explicit scheme needs lumped masses (lumped=True)")
+        self.safety = float(safety)
+        self.stable_method = stable_method
+        self.check_dt = bool(check_dt)
+        self.stable_step: StableStep | None = None
+        self._solver: ImpulseSolver | None = None
+        self._model_steps0: dict[tuple[int, int], float] = {}
+        self._critical_now: float | None = None
+        self._critical_at: int | None = None
+        self._impulse_failed = False
+        self._f_applied: np.ndarray | None = None
+        self.constraint_time = 0.0
+        super().__init__(system, dt, **kwargs)
+
+    def _equality_rows(self, constraints) -> EqualityRows:
+        # constraints with pivot dofs in their identity basis: the same corrected velocities,
+        # a diagonal-plus-low-rank impulse matrix (row_basis); multipliers reported as given
+        self.row_basis = ImpulseBasis(constraints, self.ops)
+        return self.row_basis.rows
+
+    # ------------------------------------------------------------------ stable step
+    def _impulse_solver(self) -> ImpulseSolver:
+        if self._solver is None:
+            self._solver = ImpulseSolver(self.rows, self.ops.inv_mass)
+            self._minv_cols = self.ops.inv_mass[self.rows.cols]
+            self._no_rows, self._no_lam = sp.csr_matrix((0, self.ops.n)), np.zeros(0)
+        return self._solver
+
+    def _stable(self) -> StableStep:
+        if self.stable_step is None:
+            solver = self._impulse_solver()
+            self.stable_step = stable_time_step(
+                self.system, self.stable_method, _ops=self.ops, _rows=self.rows, _s_lu=solver.lu
+            )
+            if self.damping is not None:
+                self.stable_step = self.damping.stable_step(self.stable_step)
+            self.critical_dt = self.stable_step.critical
+        return self.stable_step
+
+    def critical_time_step(self, max_age: int = 0) -> float:
+        """Critical step (s) of the coupled system in the current configuration.
+
+        The computed critical step of the initial configuration (:attr:`stable_step`), scaled by
+        ``min_m Δt_m(u)/Δt_m(0)`` over the nonlinear models that declare the
+        ``"critical_time_step"`` capability (their own element estimates in the current and the
+        initial configuration); linear systems keep the initial value.
+
+        Parameters
+        ----------
+        max_age : int
+            Return the last estimate if it was made at most this many steps ago (0: estimate
+            now).
+        """
+        crit = self._stable().critical
+        u = getattr(self, "u", None)
+        if u is None:
+            self._critical_now = crit
+            return crit
+        if (
+            self._critical_now is not None
+            and self._critical_at is not None
+            and self.step_count - self._critical_at < max(max_age, 1)
+            and max_age > 0
+        ):
+            return self._critical_now
+        self._critical_at = self.step_count
+        ratio = 1.0
+        for bi, b in enumerate(self.ops.blocks):
+            if self.ops.block_linear[bi]:
+                continue
+            for ti, term in enumerate(b.terms):
+                if "critical_time_step" not in capabilities(term.model):
+                    continue
+                key = (bi, ti)
+                ut = self.ops._term_u(b, term, u)
+                if key not in self._model_steps0:
+                    self._model_steps0[key] = float(
+                        term.model.critical_time_step(np.zeros_like(ut), None)
+                    )
+                now = float(term.model.critical_time_step(ut, self.states[b.name][ti]))
+                ratio = min(ratio, now / self._model_steps0[key])
+        self._critical_now = crit * ratio
+        return self._critical_now
+
+    def _default_controller(self) -> StepController:
+        return FixedStep(self.safety * self._stable().critical)
+
+    def _check_step_size(self, dt: float) -> float:
+        if self.check_dt:
+            stable = self._stable()
+            # the latest estimate (a CriticalFraction controller refreshes it)
+            now = self._critical_now if self._critical_now is not None else stable.critical
+            if now != stable.critical:
+                stable = StableStep(
+                    now, stable.block_bound, stable.per_block, 2.0 / now, "current-configuration"
+                )
+            check_time_step(dt, stable)
+        return dt
+
+    # ------------------------------------------------------------------ impulses
+    def _rhs_equality(self, v_star: np.ndarray, u: np.ndarray, t_next: float) -> np.ndarray:
+        """B v* − w for the equality rows, w the velocity targets of the mid-step velocity
+        ending at t_next: (g(t_next) − B u)/Δt (displacement rows), g(t_next − Δt/2) (velocity
+        rows)."""
+        rows = self.rows
+        dt = self.dt
+        cols = rows.cols
+        if rows.displacement.all():
+            # B v* − (g − B u)/Δt = B (v* + u/Δt) − g/Δt: one product on the touched dofs
+            return rows.matrix_cols @ (v_star[cols] + u[cols] / dt) - rows.g(t_next) / dt
+        disp = rows.displacement
+        bv = rows.matrix_cols @ v_star[cols]
+        bu = rows.matrix_cols @ u[cols]
+        g_end = rows.g(t_next)
+        g_mid = rows.g(t_next - 0.5 * dt) if rows.time_dependent else g_end
+        return bv - np.where(disp, (g_end - bu) / dt, g_mid)
+
+    def _impulse(self, v_star: np.ndarray, dt_bar: float):
+        """Impulses making ``v_star − M⁻¹BᵀΛ`` satisfy the rows for the step from t.
+
+        ``v_star`` is overwritten. Returns (Λ_E, Λ_A, full unilateral multipliers per constraint
+        as forces, G_A, v_new, trials).
+        """
+        rows = self.rows
+        dt = self.dt
+        u, t = self.u, self.t
+        solver = self._impulse_solver()
+        t_next = self._end_time()
+        r_e = self._rhs_equality(v_star, u, t_next) if rows.m else np.zeros(0)
+        minv = self.ops.inv_mass
+        if not self.unilateral:
+            lam_e = solver.solve_equality(r_e)
+            v_new = v_star
+            if rows.m:
+                v_new[rows.cols] -= self._minv_cols * (rows.matrix_cols_t @ lam_e)
+            self.status_iterations = 0
+            return lam_e, self._no_lam, [], self._no_rows, v_new, []
+        trials = self._begin_unilateral(t, dt, u, v_star)
+        converged = False
+        it = 0
+        v_free, r_e0 = v_star, r_e
+        while it < self.max_status_iterations:
+            it += 1
+            g_a, rhs_a, idx, disp = self._active(trials)
+            # prescribed multipliers of inactive rows (slip friction): a force during the step
+            applied = [getattr(tr, "applied", None) for tr in trials]
+            f_app = self._applied_force(trials, applied)
+            v_star, r_e = v_free, r_e0
+            if f_app is not None:
+                v_star = v_free + dt_bar * minv * f_app
+                r_e = self._rhs_equality(v_star, u, t_next) if rows.m else r_e0
+            # velocity-level rows (contact) target rhs_a itself: no product with u for them
+            w_a = np.where(disp, (rhs_a - g_a @ u) / dt, rhs_a) if disp.any() else rhs_a
+            r_a = g_a @ v_star - w_a
+            lam_e, lam_a = solver.solve(r_e, g_a, r_a)
+            v_new = v_star.copy()
+            if rows.m:
+                v_new[rows.cols] -= self._minv_cols * (rows.matrix_cols_t @ lam_e)
+            if g_a.shape[0]:
+                v_new -= minv * (transposed(g_a) @ lam_a)
+            fulls = self._full_multipliers(lam_a / dt_bar, idx)
+            if f_app is not None:
+                fulls = [f if a is None else f + a for f, a in zip(fulls, applied)]
+            self._f_applied = f_app
+            trials, changed = self._update_statuses(trials, u + dt * v_new, v_new, fulls)
+            if not changed:
+                converged = True
+                break
+        self.status_iterations = it
+        self._impulse_failed = not converged
+        if not converged:
+            # the step keeps the last solve; each constraint commits what it used in it
+            self._status_cap_reached(t_next)
+        return lam_e, lam_a, fulls, g_a, v_new, trials
+
+    def _applied_force(self, trials, applied) -> np.ndarray | None:
+        """−Σ Bᵀ λ_applied (N) of the trials' prescribed multipliers, or None without any."""
+        f = None
+        for tr, app in zip(trials, applied):
+            if app is not None and np.any(app):
+                part = -(tr.matrix.T @ app)
+                f = part if f is None else f + part
+        return f
+
+    def _impulse_at_t(self) -> None:
+        """Impulse at the current time t for the step self.dt: sets v^{n+1/2}, v^n, λ^n, the
+        constraint states after it and the powers at t."""
+        dt_prev, dt = self._dt_prev, self.dt
+        dt_bar = 0.5 * (dt_prev + dt)
+        v_minus = self._v_minus
+        v_star = self._kick(v_minus, dt_bar)
+        tic = time.perf_counter()
+        lam_e, lam_a, fulls, g_a, v_next, trials = self._impulse(v_star, dt_bar)
+        self.constraint_time += time.perf_counter() - tic
+        if trials:
+            self.constraint_states = self._commit_unilateral(
+                trials, self.t, self.u, v_minus, v_next, fulls, [dt_bar * f for f in fulls],
+                states=self._pre_impulse_states,
+            )  # fmt: skip
+        self._v_next = v_next
+        share = dt_prev / (dt_prev + dt)
+        self.v = v_minus + share * (v_next - v_minus) if share else v_minus.copy()
+        self._lam_e = lam_e
+        self._lam_a = lam_a
+        self._g_a = g_a
+        self._dt_bar = dt_bar
+        mult = self.row_basis.multipliers(lam_e / dt_bar) if self.rows.m else {}
+        for c, lam in zip(self.unilateral, fulls):
+            mult[c.name] = lam
+        self.multipliers = mult
+        # works of the step that ended at t: the trapezoidal rule on the forces at both ends
+        # times the step's own (mid-step) velocity v^{n-1/2}, the discrete work that closes the
+        # balance of the scheme's energy exactly for linear systems. Pending until the next
+        # step starts, since a new step size at t changes the forces at t.
+        half = 0.5 * dt_prev
+        # the powers of these forces with v^{n+1/2} too, which the next step needs (_step_impl):
+        # the constraint forces computed once for both, kept with v^{n+1/2} itself (never
+        # modified in place; a restored run recomputes them, to the same numbers)
+        p_now, p_next = self._powers(v_minus, v_next)
+        self._p_next = (v_next, p_next)
+        self._w_pending = tuple(half * (p + q) for p, q in zip(self._p_prev, p_now))
+
+    def _kick(self, v_minus: np.ndarray, dt_bar: float) -> np.ndarray:
+        """The free prediction v* = v^{n−½} + Δt̄_n a^n (a new array)."""
+        return v_minus + dt_bar * self.a
+
+    def _kinetic(self) -> np.ndarray:
+        """The scheme's kinetic energy per block (J): ½ ṽ^{n−½}·M v^{n+½}, with ṽ^{n−½} the
+        mid-step velocity the step Δt_n would have before t_n (v^{n−½} for a constant step)."""
+        back = self._v_next - (self.dt / self._dt_bar) * (self._v_next - self._v_minus)
+        return 0.5 * self.ops.block_dots(back, self.ops.mass * self._v_next)
+
+    def _powers(self, v: np.ndarray, v2: np.ndarray | None = None):
+        """External, coupling, other-constraint and damping powers per block (W) of the forces
+        at the current time with the velocity v (m/s): a tuple of four (n_blocks,) arrays; with
+        a second velocity v2, the pair of those tuples (the constraint forces computed once)."""
+        vs = (v,) if v2 is None else (v, v2)
+        nb = len(self.ops.blocks)
+        if self.rows.m:
+            cols = self.rows.cols
+            eq = self.rows.block_powers_of(self._lam_e / self._dt_bar, [x[cols] for x in vs])
+        else:
+            eq = [(np.zeros(nb), np.zeros(nb)) for _ in vs]
+        uni = unilateral_block_powers(self.ops, self._g_a, self._lam_a / self._dt_bar, vs) \
+            if self._g_a.shape[0] else None  # fmt: skip
+        out = []
+        for i, x in enumerate(vs):
+            pc, po = eq[i]
+            if uni is not None:
+                po = po + uni[i]
+            p_ext = self.ops.block_dots(self._f_ext, x) if self._f_ext is not None else \
+                np.zeros(nb)  # fmt: skip
+            if self._f_applied is not None:  # slip friction
+                po = po + self.ops.block_dots(self._f_applied, x)
+            p_damp = np.zeros(nb) if self._f_damp is None else \
+                -self.ops.block_dots(self._f_damp, x)  # fmt: skip
+            out.append((p_ext, pc, po, p_damp))
+        return out[0] if v2 is None else (out[0], out[1])
+
+    def _damping_force(self, v: np.ndarray) -> np.ndarray | None:
+        """C v (N) with the mid-step velocity v that precedes the force's time, or None."""
+        if self.damping is None:
+            return None
+        if self._c_matrix is None:
+            self._c_matrix = self.damping.matrix(self.ops.mass, self.ops.initial_stiffness())
+        return self._c_matrix @ v
+
+    def _forces(
+        self, u: np.ndarray, t: float, dt: float | None = None, blocks=None
+    ) -> tuple[np.ndarray, np.ndarray | None, dict]:
+        # blocks: the block indices whose internal force is evaluated (None: all)
+        f_int, trial, _ = self.ops.internal_force(u, self.states, dt=dt, blocks=blocks)
+        f_ext = self.system.external_force(t) if self.system.load is not None else None
+        if f_ext is not None and not f_ext.any():
+            f_ext = None  # unloaded at t: skip the force and its power
+        return f_int, f_ext, trial
+
+    def _acceleration(self, f_int: np.ndarray, f_ext: np.ndarray | None) -> np.ndarray:
+        minv = self.ops.inv_mass
+        return -minv * f_int if f_ext is None else minv * (f_ext - f_int)
+
+    # ------------------------------------------------------------------ initial state
+    def _initialize(self) -> None:
+        f_int, f_ext, trial = self._forces(self.u, self.t)
+        self.states = trial
+        self._f_int = f_int
+        self._f_ext = f_ext
+        self._v_minus = self.v.copy()  # v^{-1/2} = v^0: the first kick is a half step
+        self._f_damp = self._damping_force(self._v_minus)
+        f_all = f_int if self._f_damp is None else f_int + self._f_damp
+        self.a = self._acceleration(f_all, f_ext)
+        self._dt_prev = 0.0
+        self._pre_impulse_states = self.constraint_states
+        nb = len(self.ops.blocks)
+        self._p_prev = (np.zeros(nb), np.zeros(nb), np.zeros(nb), np.zeros(nb))
+        self._impulse_at_t()
+
+    def _step_size_changed(self) -> None:
+        # the impulse at t and everything reported at t depend on the step that follows it
+        if self._impulse_failed:
+            self.n_status_failures -= 1  # that impulse is replaced
+        self.constraint_states = self._pre_impulse_states
+        self._impulse_at_t()
+
+    def _works(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        pe, pc, po, _ = self._w_pending
+        return self._w_ext + pe, self._w_coupling + pc, self._w_constraint + po
+
+    def _damping_work(self) -> np.ndarray:
+        return self._w_damping + self._w_pending[3]
+
+    def _scheme_fields(self) -> tuple[str, ...]:
+        return (
+            "_v_next", "_v_minus", "_dt_prev", "_dt_bar", "_f_int", "_f_ext", "_lam_e", "_lam_a",
+            "_g_a", "_p_prev", "_w_pending", "_pre_impulse_states", "_critical_now",
+            "_critical_at", "_impulse_failed", "_f_applied", "_f_damp",
+        )  # fmt: skip
+
+    # ------------------------------------------------------------------ step
+    def _step_impl(self) -> None:
+        dt = self.dt
+        t_new = self._end_time()
+        v_half = self._v_next
+        u_new = self.u + dt * v_half
+        f_int, f_ext, trial = self._forces(u_new, t_new, dt)
+        f_damp = self._damping_force(v_half)  # −C v^{n+1/2}: the damping force at t_{n+1}
+        a_new = self._acceleration(f_int if f_damp is None else f_int + f_damp, f_ext)
+        # the step size at t is final now: commit the works of the step that ended at t
+        self._w_ext, self._w_coupling, self._w_constraint = self._works()
+        self._w_damping = self._damping_work()
+        # the forces at t with this step's velocity (computed with the impulse at t)
+        cached = getattr(self, "_p_next", None)
+        self._p_prev = cached[1] if cached is not None and cached[0] is v_half else \
+            self._powers(v_half)  # fmt: skip
+        # commit the step's kinematics and model states
+        if not self.ops.linear:
+            self._w_internal += self.ops.block_dots(u_new - self.u, 0.5 * (self._f_int + f_int))
+        self.u = u_new
+        self.a = a_new
+        self.states = trial
+        self.t = t_new
+        self._f_int = f_int
+        self._f_ext = f_ext
+        self._f_damp = f_damp
+        self._dt_prev = dt
+        self._v_minus = v_half
+        self.step_size = dt
+        self.step_count += 1
+        self._phase_advanced()
+        # the next step and the impulse at t_{n+1} that depends on it
+        try:
+            self.dt = self._next_step_size()
+            self._pre_impulse_states = self.constraint_states
+            self._impulse_at_t()
+            # a non-finite u or a (NaN, overflow) shows in u or v here
+            self._check_finite(t_new, self.u, self.v, step=self.step_count)
+        except SimulationError:
+            self.status = "failed"
+            raise
+
+    # ------------------------------------------------------------------ info
+    @property
+    def mid_step_velocity(self) -> np.ndarray:
+        """v^{n+1/2} (m/s): the velocity of the next step, already constrained."""
+        return self._v_next

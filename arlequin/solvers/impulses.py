@@ -1,0 +1,240 @@
+"""The impulse solve of the explicit scheme: (B M⁻¹ Bᵀ) Λ = r for the equality rows plus the
+active unilateral rows (contact), with the equality block factorised once and the active rows
+added by a Schur complement (dense, cached by the rows' content) or one sparse factorisation
+when there are many of them."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..contract import ConstraintError
+from .linalg import dense_cho_factor, dense_cho_solve, factor_checked, factor_rows
+
+__all__ = ["ImpulseSolver"]
+
+
+class ImpulseSolver:
+    """Solves (B M⁻¹ Bᵀ) Λ = r for the equality rows E plus the active unilateral rows A.
+
+    The equality block S_EE is factorised once (:func:`~arlequin.solvers.linalg.factor_rows`:
+    by a low-rank split under a fine mediator); active rows enter by a Schur complement
+    (dense, cached for the last active rows, keyed by their content), or by a sparse
+    factorisation of the whole matrix when there are many of them.
+    """
+
+    _DENSE_SCHUR = 300
+
+    def __init__(self, rows, inv_mass: np.ndarray) -> None:
+        self.rows = rows
+        self.inv_mass = inv_mass
+        self.m_e = rows.m
+        if self.m_e:
+            self.lu = factor_rows(
+                rows.matrix_cols, inv_mass[rows.cols],
+                "the impulse matrix B M⁻¹ Bᵀ of the equality rows", rows.row_name,
+            )  # fmt: skip
+        else:
+            self.lu = None
+        self._s_ee: sp.csc_matrix | None = None
+        # Bᵀ of the equality rows, once (the Schur complement's S_AE = G_A M⁻¹ Bᵀ every step)
+        self._eq_t = rows.matrix.T.tocsr() if self.m_e else None
+        self._last: tuple[tuple, Any] | None = None  # the last active rows' arrays, factor
+        self._eq_t_rows: tuple | None = None  # _shared_part's last slice of Bᵀ
+        self._eq_mask = np.zeros(inv_mass.size, dtype=bool)
+        if self.m_e:
+            self._eq_mask[rows.cols] = True
+        # the equality rows decoupled from the others in S_EE, and their diagonal entries
+        self._free = np.zeros(self.m_e, dtype=bool)
+        self._free_diag = np.zeros(self.m_e)
+        decoupled = getattr(self.lu, "decoupled_rows", None)
+        if decoupled is not None:
+            idx, diag = decoupled()
+            self._free[idx] = True
+            self._free_diag[idx] = diag
+
+    @property
+    def s_ee(self) -> sp.csc_matrix:
+        """B M⁻¹ Bᵀ of the equality rows (built on first use: it is dense by blocks under a
+        fine mediator)."""
+        if self._s_ee is None:
+            bj = self.rows.matrix_cols
+            self._s_ee = (bj @ sp.diags(self.inv_mass[self.rows.cols]) @ bj.T).tocsc()
+        return self._s_ee
+
+    def solve_equality(self, r: np.ndarray) -> np.ndarray:
+        """Λ_E (N·s per row unit) of the equality rows alone for the right-hand side r (m_E,)."""
+        return self.lu.solve(r) if self.m_e else np.zeros(0)
+
+    def _cached(self, key: tuple, build):
+        """The factorisation for the active rows ``key`` (their CSR arrays): the last one if
+        they are the same rows, else ``build()``. One entry: the rows change with the
+        statuses or, on a deforming contact, at every step, so comparing the arrays (a few µs)
+        replaced hashing them (50 µs a step of the ball impact)."""
+        last = self._last
+        if (
+            last is not None
+            and len(last[0]) == len(key)
+            and all(a.shape == b.shape and np.array_equal(a, b) for a, b in zip(last[0], key))
+        ):
+            return last[1]
+        fac = build()
+        self._last = (tuple(np.array(a, copy=True) for a in key), fac)
+        return fac
+
+    @staticmethod
+    def _key(g_a: sp.csr_matrix) -> tuple:
+        return (np.asarray(g_a.shape), g_a.indptr, g_a.indices, g_a.data)
+
+    def solve(self, r_e: np.ndarray, g_a: sp.csr_matrix, r_a: np.ndarray):
+        """Return (Λ_E, Λ_A) for right-hand sides r_e (m_E,), r_a (m_A,) and active rows g_a."""
+        m_a = g_a.shape[0]
+        if m_a == 0:
+            return self.solve_equality(r_e), np.zeros(0)
+        key = self._key(g_a)
+        minv = self.inv_mass
+
+        def ga_m() -> sp.csr_matrix:
+            # G_A M⁻¹ by scaling its entries (no diagonal matrix, no product), for the sparse
+            # factorisations only (a matrix object a step cost more than the dense Schur path)
+            return sp.csr_matrix((g_a.data * minv[g_a.indices], g_a.indices.copy(),
+                                  g_a.indptr.copy()), shape=g_a.shape)  # fmt: skip
+
+        if self.m_e and not self._eq_mask[g_a.indices].any():
+            # no dof shared with the equality rows (a wall and a symmetry axis): two blocks
+            def build_aa_only():
+                s_aa = (ga_m() @ g_a.T).tocsr()
+                return factor_checked(s_aa, "the impulse matrix of the active rows", spd=True)
+
+            return self.solve_equality(r_e), self._cached(key, build_aa_only).solve(r_a)
+        if self.m_e == 0:
+
+            def build_aa():
+                s_aa = (ga_m() @ g_a.T).tocsr()
+                return factor_checked(s_aa, "the impulse matrix of the active rows", spd=True)
+
+            return np.zeros(0), self._cached(key, build_aa).solve(r_a)
+        if m_a <= self._DENSE_SCHUR:
+            e_rows, s_ae_e = self._shared_part(g_a)
+            if self._free[e_rows].all():
+                # the equality rows the active rows meet (a symmetry axis under the contact)
+                # are decoupled in S_EE (divisions): the Schur complement and the corrections
+                # on those rows alone, dense
+                d_e = self._free_diag[e_rows]
+
+                def build_decoupled():
+                    schur = _dense_gram(g_a, minv)
+                    if e_rows.size:
+                        schur -= (s_ae_e / d_e) @ s_ae_e.T
+                    return self._cholesky(schur, m_a)
+
+                cho = self._cached(key, build_decoupled)
+                y = self.lu.solve(r_e)
+                lam_a = dense_cho_solve(cho, r_a - s_ae_e @ y[e_rows]) if e_rows.size else \
+                    dense_cho_solve(cho, r_a)  # fmt: skip
+                if e_rows.size:
+                    y[e_rows] -= (s_ae_e.T @ lam_a) / d_e
+                return y, lam_a
+        s_ae = self._s_ae(g_a)
+        if m_a <= self._DENSE_SCHUR:
+
+            def build_schur():
+                schur = _dense_gram(g_a, minv)
+                # only the active rows that share a dof with the equality rows have a non-zero
+                # column in (B M⁻¹ G_Aᵀ): solve for those alone (a few near a symmetry axis)
+                coupled = np.nonzero(np.diff(s_ae.indptr))[0]
+                x = self.lu.solve(_dense_rows_t(s_ae, coupled, self.m_e)) if coupled.size \
+                    else np.zeros((self.m_e, 0))  # fmt: skip
+                if coupled.size:
+                    schur[:, coupled] -= s_ae @ x
+                return coupled, x, self._cholesky(schur, m_a)
+
+            coupled, x, cho = self._cached(key, build_schur)
+            y = self.lu.solve(r_e)
+            lam_a = dense_cho_solve(cho, r_a - s_ae @ y)
+            if coupled.size:
+                y = y - x @ lam_a[coupled]
+            return y, lam_a
+
+        s_ae = s_ae.tocsr()
+
+        def build_full():
+            s_aa = (ga_m() @ g_a.T).tocsr()
+            full = sp.bmat([[self.s_ee, s_ae.T], [s_ae, s_aa]], format="csc")
+            return factor_checked(full, "the impulse matrix with the active rows", spd=True)
+
+        sol = self._cached(key, build_full).solve(np.concatenate([r_e, r_a]))
+        return sol[: self.m_e], sol[self.m_e :]
+
+    @staticmethod
+    def _cholesky(schur: np.ndarray, m_a: int):
+        try:
+            return dense_cho_factor(schur)
+        except np.linalg.LinAlgError as exc:
+            raise ConstraintError(
+                "active unilateral rows are dependent on each other or on the equality rows "
+                f"({m_a} active rows)"
+            ) from exc
+
+    def _shared_part(self, g_a: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray]:
+        """(the equality rows e that share a dof with the active rows, S_AE[:, e] dense
+        (m_A, len(e))): G_A M⁻¹ on the shared dofs (a few) times those rows of Bᵀ."""
+        shared = self._eq_mask[g_a.indices]
+        m_a = g_a.shape[0]
+        if not shared.any():
+            return np.zeros(0, dtype=np.int64), np.zeros((m_a, 0))
+        idx = g_a.indices[shared]
+        sh, pos = np.unique(idx, return_inverse=True)
+        g = np.zeros((m_a, sh.size))
+        np.add.at(g, (np.repeat(np.arange(m_a), np.diff(g_a.indptr))[shared], pos),
+                  g_a.data[shared] * self.inv_mass[idx])  # fmt: skip
+        # Bᵀ's rows on those dofs, dense on the equality rows they touch: the same few (the
+        # axis under the contact) step after step
+        cached = self._eq_t_rows
+        if cached is None or not np.array_equal(cached[0], sh):
+            part = self._eq_t[sh].tocsc()
+            e_rows = np.nonzero(np.diff(part.indptr))[0]
+            cached = (sh, e_rows, part[:, e_rows].toarray())
+            self._eq_t_rows = cached
+        return cached[1], g @ cached[2]
+
+    def _s_ae(self, g_a: sp.csr_matrix) -> sp.csr_matrix:
+        """S_AE = G_A M⁻¹ Bᵀ (m_A, m_E) from the entries of G_A on dofs the equality rows touch
+        (a few, on a symmetry axis), not from a product with every equality row (147 µs a step
+        of the ball impact's deformable contact, against a few here)."""
+        shared = self._eq_mask[g_a.indices]
+        m_a = g_a.shape[0]
+        if not shared.any():
+            return sp.csr_matrix((m_a, self.m_e))
+        cols, pos = np.unique(g_a.indices[shared], return_inverse=True)
+        row = np.repeat(np.arange(m_a), np.diff(g_a.indptr))[shared]
+        indptr = np.zeros(m_a + 1, dtype=np.int64)
+        np.cumsum(np.bincount(row, minlength=m_a), out=indptr[1:])
+        data = g_a.data[shared] * self.inv_mass[g_a.indices[shared]]
+        part = sp.csr_matrix((data, pos, indptr), shape=(m_a, cols.size))
+        return (part @ self._eq_t[cols]).tocsr()
+
+
+def _dense_gram(g: sp.csr_matrix, minv: np.ndarray) -> np.ndarray:
+    """G M⁻¹ Gᵀ (m, m) of a few sparse rows, dense: the rows scattered on the columns they
+    touch, one matrix product (scipy's sparse product and its conversion cost more, every
+    step of a deformable contact)."""
+    cols, pos = np.unique(g.indices, return_inverse=True)
+    m = g.shape[0]
+    dense = np.zeros((m, cols.size))
+    dense[np.repeat(np.arange(m), np.diff(g.indptr)), pos] = g.data
+    return (dense * minv[cols]) @ dense.T
+
+
+def _dense_rows_t(mat: sp.csr_matrix, rows: np.ndarray, n: int) -> np.ndarray:
+    """``mat[rows].T.toarray()`` (n, len(rows)) of a CSR matrix without duplicate entries,
+    scattered from its arrays (scipy's row indexing and transpose cost more than the solve
+    they feed, every step of a deformable contact)."""
+    start = mat.indptr[rows]
+    cnt = mat.indptr[rows + 1] - start
+    pos = np.repeat(start - (np.cumsum(cnt) - cnt), cnt) + np.arange(int(cnt.sum()))
+    out = np.zeros((n, rows.size), order="F")  # the layout of toarray's: the same products
+    out[mat.indices[pos], np.repeat(np.arange(rows.size), cnt)] = mat.data[pos]
+    return out

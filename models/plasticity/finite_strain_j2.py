@@ -1,0 +1,477 @@
+"""Finite-strain J2 elastoplasticity (Simo 1992), total Lagrangian, with an optional weight.
+
+The model ties three pieces together: the Q1 kinematics with F-bar
+(:mod:`arlequin.models.plasticity.kinematics`), the J2 material point
+(:mod:`arlequin.models.plasticity.j2`: Hencky elasticity, exponential-map return, any hardening law
+of
+:mod:`arlequin.models.plasticity.hardening`) and, for the built-in hardening laws, the compiled
+kernels that fuse them (``backend="numba"``, the default there):
+:mod:`arlequin.models.plasticity.j2_kernel` for planar cells (axisymmetric, plane strain),
+:mod:`arlequin.models.plasticity.j2_kernel_3d` for hexahedra. The numpy path (``backend="numpy"``)
+is the reference the kernels are tested against.
+
+Optional artificial bulk viscosity (off by default): on compression a pressure
+q = ρ (c_quad ℓ² ε̇_v² − c_lin ℓ c_d ε̇_v) (ε̇_v = J̄̇/J̄ from the step, ρ = ρ₀/J̄, ℓ the cell size)
+is added to the stress; its work is accumulated in the state (``viscous_work``) like the plastic
+work (``plastic_work``), so that energy balances can count both.
+
+Units: SI (m, kg, s, Pa, N). Quadrature-point arrays have shape (components…, n_elems, n_qp).
+The model knows nothing about Arlequin: ``weight`` (α at quadrature points, default 1) scales
+every integrand.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+from skfem import Basis, Mesh
+
+from arlequin.contract import StateError
+
+from ..elastic import LinearElastic, WeightLike, element_critical_step
+from .j2 import (
+    InvertedElementError,
+    J2Material,
+    PlasticState,
+    hencky_j2_return,
+    hencky_strain,
+    j2_return_map,
+)
+from .kinematics import KINDS, Q1Kinematics  # noqa: F401  (KINDS re-exported)
+
+__all__ = [
+    "BACKENDS",
+    "BulkViscosity",
+    "FiniteStrainJ2",
+    "InvertedElementError",
+    "J2Material",
+    "PlasticState",
+    "hencky_j2_return",
+]
+
+#: Backends of the internal force: the compiled kernel (planar cells) and the numpy reference.
+BACKENDS = ("auto", "numba", "numpy")
+
+
+@dataclass(frozen=True)
+class BulkViscosity:
+    """Artificial bulk viscosity (LS-DYNA's defaults): q = ρ (c_quad ℓ² ε̇_v² − c_lin ℓ c_d ε̇_v)
+    on compression. Both coefficients dimensionless, ≥ 0."""
+
+    linear: float = 0.06
+    quadratic: float = 1.5
+
+    def __post_init__(self) -> None:
+        for name in ("linear", "quadratic"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v >= 0.0):
+                raise ValueError(f"bulk viscosity coefficient {name} must be >= 0, got {v}")
+
+
+class FiniteStrainJ2:
+    """Finite-strain J2 elastoplastic model with F-bar on one Q1 mesh (explicit dynamics).
+
+    Parameters
+    ----------
+    mesh : skfem.MeshQuad or skfem.MeshHex
+        Reference (undeformed) mesh, in m. Axisymmetric meshes use (r, z) = (x[0], x[1]).
+    material : J2Material
+    kind : {"axisymmetric", "plane_strain", "3d"}
+        Default ``"axisymmetric"`` for quads and ``"3d"`` for hexahedra.
+    fbar : bool
+        Use the F-bar deformation gradient (default). Without it, isochoric plastic flow
+        locks the bilinear cells.
+    backend : {"auto", "numba", "numpy"}
+        ``auto``: the compiled kernel for planar cells with a built-in hardening law, numpy
+        otherwise (3D cells, user hardening callables).
+    bulk_viscosity : BulkViscosity or bool, optional
+        Artificial bulk viscosity (True: the default coefficients).
+    validate, allow_seams : bool
+        Mesh checks (see :class:`~arlequin.models.LinearElastic`).
+
+    Notes
+    -----
+    Quadrature: 2×2 (2×2×2) Gauss points; F-bar uses the cell's mean dilatation J̄. Dofs are
+    interleaved by node (``dim * node + component``); :meth:`mass` and :meth:`stiffness`
+    (small-strain elastic, for stable-step estimates) come from a
+    :class:`~arlequin.models.LinearElastic` on the same mesh and quadrature. Capabilities
+    (:mod:`arlequin.contract`): ``"critical_time_step"`` in the current configuration; no
+    ``"tangent"`` (explicit dynamics; implicit schemes refuse it, or use ``newton="initial"``).
+    ``uses_time_step`` is True when the state update needs the step (rate-dependent hardening,
+    bulk viscosity): the integrators then pass ``dt=`` to :meth:`internal_force`.
+    """
+
+    is_linear = False
+
+    def __init__(
+        self, mesh: Mesh, material: J2Material, kind: str | None = None, fbar: bool = True, *,
+        backend: str = "auto", bulk_viscosity: BulkViscosity | bool | None = None,
+        validate: bool = True, allow_seams: bool = False,
+    ) -> None:  # fmt: skip
+        if not isinstance(material, J2Material):
+            raise ValueError(f"material must be a J2Material, got {type(material).__name__}")
+        dim = mesh.dim()
+        kind = ("axisymmetric" if dim == 2 else "3d") if kind is None else kind
+        if backend not in BACKENDS:
+            raise ValueError(f"backend must be one of {BACKENDS}, got {backend!r}")
+        self.mesh = mesh
+        self.material = material
+        self.kind = kind
+        self.fbar = bool(fbar)
+        self.dim = dim
+        self.intorder = 3
+        checks = {"validate": validate, "allow_seams": allow_seams}
+        # checks r >= 0 in axisymmetry; gives the mass, the small-strain stiffness and the bases
+        self.elastic = LinearElastic(mesh, material.elastic, kind, intorder=self.intorder, **checks)
+        self.basis = self.elastic.basis
+        self.kin = Q1Kinematics(mesh, kind, self.elastic.scalar_basis(), self.elastic.nodal_dofs())
+        # the compiled kernels: planar Q1 (j2_kernel) and 8-node hexahedra (j2_kernel_3d)
+        compiled = material.law.kernel_code is not None
+        if backend == "numba" and not compiled:
+            raise ValueError("backend='numba' needs a built-in hardening law; use backend='numpy'")
+        self.backend = "numba" if (backend == "auto" and compiled) else backend
+        if self.backend == "auto":
+            self.backend = "numpy"
+        if bulk_viscosity is True:
+            bulk_viscosity = BulkViscosity()
+        self.bulk_viscosity = bulk_viscosity or None
+        self.uses_time_step = bool(self.bulk_viscosity) or material.law.rate_dependent
+        # reference cell size ℓ₀ (m): √(meridional area) in 2D, ∛(volume) in 3D
+        area = self.kin.dv0.sum(axis=1) / self._measure_factor()
+        self._h0 = np.sqrt(area) if dim == 2 else np.cbrt(area)
+        self._critical_ratio: np.ndarray | None = None
+        self._kernel_static: tuple | None = None  # contiguous inputs and scratch of the kernel
+        self._ones: np.ndarray | None = None
+        self._alpha_of: tuple | None = None  # (read-only weight, its checked broadcast)
+
+    def _measure_factor(self) -> np.ndarray:
+        if self.kind == "axisymmetric":
+            return 2.0 * np.pi * self.kin.radius.mean(axis=1)
+        return np.ones(self.kin.shape[0])
+
+    # ------------------------------------------------------------------ model protocol
+    @property
+    def n_dofs(self) -> int:
+        """Number of displacement dofs."""
+        return self.elastic.n_dofs
+
+    @property
+    def n_components(self) -> int:
+        return self.dim
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        """(n_elems, n_qp) of the quadrature-point arrays."""
+        return self.kin.shape
+
+    def with_mesh(self, mesh: Mesh) -> FiniteStrainJ2:
+        """Same material, kinematics, F-bar choice, backend and viscosity on another mesh."""
+        return FiniteStrainJ2(mesh, self.material, self.kind, self.fbar, backend=self.backend,
+                              bulk_viscosity=self.bulk_viscosity, validate=False)  # fmt: skip
+
+    def nodal_dofs(self) -> np.ndarray:
+        """Dof indices per node, shape (dim, n_nodes)."""
+        return self.kin.dofs
+
+    def dofs_where(self, where, components=None) -> np.ndarray:
+        """Dofs of the nodes where ``where(x)`` holds (see :meth:`LinearElastic.dofs_where`)."""
+        return self.elastic.dofs_where(where, components)
+
+    def scalar_basis(self) -> Basis:
+        """Scalar Q1 basis with the model's quadrature."""
+        return self.elastic.scalar_basis()
+
+    def quadrature_points(self) -> np.ndarray:
+        """Reference quadrature points, shape (dim, n_elems, n_qp) (m)."""
+        return self.elastic.quadrature_points()
+
+    def mass(self, weight: WeightLike = None, lumped: bool = False):
+        """Weighted reference mass ∫ α ρ₀ u·v dV₀ (kg); row sums when ``lumped``."""
+        return self.elastic.mass(weight, lumped=lumped)
+
+    def stiffness(self, weight: WeightLike = None) -> sp.csr_matrix:
+        """Small-strain elastic stiffness (N/m): the initial tangent, for stable-step estimates."""
+        return self.elastic.stiffness(weight)
+
+    def body_force_vector(self, force, weight: WeightLike = None) -> np.ndarray:
+        """Dead body load ∫ α ρ₀b·v dV₀ (N) for a force density (N/m³ of reference volume)."""
+        return self.elastic.body_force_vector(force, weight)
+
+    def traction_vector(self, facets: np.ndarray, traction, weight: WeightLike = None):
+        """Dead traction load (N) for a nominal traction (Pa, per reference area) on ``facets``."""
+        return self.elastic.traction_vector(facets, traction, weight)
+
+    def initial_state(self, weight: WeightLike = None) -> PlasticState:
+        """Virgin state: C_p⁻¹ = 1, ε̄p = 0, τ = 0, J = 1, no work."""
+        ne, nq = self.shape
+        eye = np.broadcast_to(np.eye(3)[:, :, None, None], (3, 3, ne, nq)).copy()
+        zeros = np.zeros((ne, nq))
+        return PlasticState(eye, zeros, np.zeros((3, 3, ne, nq)), np.ones((ne, nq)), zeros,
+                            zeros.copy())  # fmt: skip
+
+    # ------------------------------------------------------------------ kinematics
+    def deformation_gradient(self, u: np.ndarray) -> np.ndarray:
+        """Deformation gradient at the quadrature points, shape (3, 3, n_elems, n_qp).
+
+        In 2D, F_zz = 1 (plane strain) or F_θθ = 1 + u_r/R (axisymmetric).
+        """
+        return self.kin.deformation_gradient(u)
+
+    def _kinematics(self, u: np.ndarray):
+        return self.kin.kinematics(u, self.fbar)
+
+    def _mean_dilatation(self, J: np.ndarray) -> np.ndarray:
+        return self.kin.mean_dilatation(J)
+
+    # ------------------------------------------------------------------ internal force
+    def internal_force(
+        self,
+        u: np.ndarray,
+        state: PlasticState | None = None,
+        weight: WeightLike = None,
+        dt: float | None = None,
+    ) -> tuple[np.ndarray, PlasticState]:
+        """Internal force (N) at displacement ``u`` from the committed ``state``.
+
+        Parameters
+        ----------
+        u : ndarray, shape (n_dofs,)
+            Displacement from the reference configuration (m).
+        state : PlasticState, optional
+            Committed state (default: virgin).
+        weight : float, array (n_elems, n_qp) or callable, optional
+            Partition weight α at the quadrature points.
+        dt : float, optional
+            The step that leads to u (s): rates of rate-dependent laws and of the bulk
+            viscosity (ignored by rate-independent models without viscosity).
+
+        Returns
+        -------
+        f : ndarray, shape (n_dofs,)
+        trial_state : PlasticState
+            The state after this evaluation, to be committed by the integrator.
+
+        Raises
+        ------
+        InvertedElementError
+            When det F ≤ 0 (or is not finite) at a quadrature point, naming the cell.
+        """
+        state = self.initial_state() if state is None else state
+        if weight is None:  # the common case: one array of ones, made once
+            if self._ones is None:
+                self._ones = np.ones(self.shape)
+            alpha = self._ones
+        elif isinstance(weight, np.ndarray) and not weight.flags.writeable:
+            # a read-only weight array cannot change between steps: checked and broadcast
+            # once (an integrator passes the same one at every step)
+            if self._alpha_of is None or self._alpha_of[0] is not weight:
+                self._alpha_of = (weight, self.elastic.weight_at_quadrature(weight))
+            alpha = self._alpha_of[1]
+        else:
+            alpha = self.elastic.weight_at_quadrature(weight)
+        if state.plastic_work is None:  # a state built by hand: no work accumulated yet
+            zeros = np.zeros(self.shape)
+            state = PlasticState(state.cp_inv, state.eqps, state.kirchhoff, state.jacobian,
+                                 zeros, zeros.copy())  # fmt: skip
+        if self.backend == "numba":
+            return self._internal_force_numba(u, state, alpha, dt)
+        return self._internal_force_numpy(u, state, alpha, dt)
+
+    def _viscous_pressure(self, jbar: np.ndarray, jbar_old: np.ndarray, dt: float | None):
+        """q (Pa) per cell, shape (n_elems, 1), of the bulk viscosity (0 where off/expanding)."""
+        if not self.bulk_viscosity or dt is None or not dt > 0.0:
+            return np.zeros_like(jbar)
+        rate = (jbar - jbar_old) / (dt * jbar)
+        ell = self._h0[:, None] * np.sqrt(jbar)
+        rho = self.material.density / jbar
+        bv, cd = self.bulk_viscosity, self.material.dilatational_wave_speed
+        q = rho * (bv.quadratic * ell**2 * rate**2 - bv.linear * ell * cd * rate)
+        return np.where(rate < 0.0, q, 0.0)
+
+    def _internal_force_numpy(self, u, state, alpha, dt):
+        trial = self.kin.trial_elastic_stretch(u, state.cp_inv, self.fbar)
+        F, Finv, J = trial.F, trial.Finv, trial.J
+        tau, be, eqps, dgamma, work = j2_return_map(
+            trial.B, state.eqps, self.material, planar=self.dim == 2, dt=dt,
+            minus_identity=True, log_volume=trial.log_volume,
+        )  # fmt: skip
+        Fbar_inv = Finv / trial.scale
+        # C_p⁻¹ = F̄⁻¹ b_e F̄⁻ᵀ changes only where the point flowed (elsewhere: kept bit for bit)
+        cp_inv = np.where(
+            dgamma > 0.0,
+            np.einsum("ikeq,kleq,jleq->ijeq", Fbar_inv, be, Fbar_inv),
+            state.cp_inv,
+        )
+        w0 = alpha * self.kin.dv0
+        jbar = self._mean_dilatation(J)
+        q = self._viscous_pressure(jbar, self._mean_dilatation(state.jacobian), dt)
+        tau_total = tau - (J * q)[None, None] * np.eye(3)[:, :, None, None]
+        f = self.kin.internal_force(tau_total, F, Finv, J, w0, self.fbar)
+        wv = state.viscous_work + q * (self._mean_dilatation(state.jacobian) - jbar)
+        return f, PlasticState(cp_inv, eqps, tau, J, state.plastic_work + work, wv)
+
+    def _internal_force_numba(self, u, state, alpha, dt):
+        if self.dim == 3:
+            return self._internal_force_numba_3d(u, state, alpha, dt)
+        from .j2_kernel import planar_j2_kernel, scratch
+
+        kin = self.kin
+        ne, nq = self.shape
+        nen = kin.grad.shape[0]
+        law = self.material.law
+        if self._kernel_static is None:
+            c = np.ascontiguousarray
+            radius = kin.radius if kin.radius is not None else np.ones((ne, nq))
+            visc = self._viscosity_params()
+            self._kernel_static = (
+                c(np.transpose(kin.cell_dofs, (2, 1, 0)), dtype=np.int64),
+                c(np.moveaxis(kin.grad, (0, 1), (2, 3))), c(np.moveaxis(kin.val, 0, -1)),
+                c(radius), c(kin.dv0),
+                visc, c(self._h0), *scratch(nq, nen),
+            )  # fmt: skip
+        dofs, grad, val, radius, dv0, visc, h0, s_h, s_g, s_u = self._kernel_static
+        u = self._checked_displacement(u)
+        out = self._kernel_outputs(2)
+        c = np.ascontiguousarray
+        # the weight goes in as a read-only broadcast view whatever its source: one type to
+        # numba, the one warm_up compiles
+        planar_j2_kernel(
+            u, dofs, grad, val, radius, dv0, c(np.broadcast_to(alpha, (ne, nq)), dtype=float),
+            self.kind == "axisymmetric", self.fbar, self.material.bulk_modulus,
+            self.material.shear_modulus, int(law.kernel_code), law.kernel_params,
+            -1.0 if dt is None else float(dt), c(state.cp_inv), c(state.eqps),
+            c(state.plastic_work), c(state.viscous_work), c(state.jacobian), visc, h0,
+            s_h, s_g, s_u, *out,
+        )  # fmt: skip
+        return self._gathered(out)
+
+    def _internal_force_numba_3d(self, u, state, alpha, dt):
+        from .j2_kernel_3d import solid_j2_kernel, solid_scratch
+
+        kin = self.kin
+        ne, nq = self.shape
+        nen = kin.grad.shape[0]
+        law = self.material.law
+        c = np.ascontiguousarray
+        if self._kernel_static is None:
+            self._kernel_static = (
+                c(np.transpose(kin.cell_dofs, (2, 1, 0)), dtype=np.int64),
+                c(np.moveaxis(kin.grad, (0, 1), (2, 3))), c(kin.dv0), self._viscosity_params(),
+                c(self._h0), *solid_scratch(nq, nen),
+            )  # fmt: skip
+        dofs, grad, dv0, visc, h0, s_h, s_g, s_m = self._kernel_static
+        u = self._checked_displacement(u)
+        out = self._kernel_outputs(3)
+        # the weight as a read-only broadcast view, the type warm_up_solid compiles
+        solid_j2_kernel(
+            u, dofs, grad, dv0, c(np.broadcast_to(alpha, (ne, nq)), dtype=float), self.fbar,
+            self.material.bulk_modulus, self.material.shear_modulus, int(law.kernel_code),
+            law.kernel_params, -1.0 if dt is None else float(dt), c(state.cp_inv),
+            c(state.eqps), c(state.plastic_work), c(state.viscous_work), c(state.jacobian),
+            visc, h0, s_h, s_g, s_m, *out,
+        )  # fmt: skip
+        return self._gathered(out)
+
+    def _viscosity_params(self) -> np.ndarray:
+        """(c_linear, c_quadratic, ρ₀, c_d) of the bulk viscosity for the kernels (0: off)."""
+        visc = np.zeros(4)
+        if self.bulk_viscosity:
+            bv = self.bulk_viscosity
+            visc[:] = (bv.linear, bv.quadratic, self.material.density,
+                       self.material.dilatational_wave_speed)  # fmt: skip
+        return visc
+
+    def _checked_displacement(self, u) -> np.ndarray:
+        u = np.ascontiguousarray(u, dtype=float)
+        if u.shape != (self.kin.n_dofs,):
+            raise ValueError(f"displacement must have shape ({self.kin.n_dofs},), got {u.shape}")
+        return u
+
+    def _kernel_outputs(self, dim: int) -> list[np.ndarray]:
+        """The kernels' output buffers: forces, C_p⁻¹, ε̄p, τ, J, works, flags."""
+        ne, nq = self.shape
+        nen = self.kin.grad.shape[0]
+        return [np.empty((dim, nen, ne)), np.empty((3, 3, ne, nq)), np.empty((ne, nq)),
+                np.empty((3, 3, ne, nq)), np.empty((ne, nq)), np.empty((ne, nq)),
+                np.empty((ne, nq)), np.empty(ne, dtype=np.int64)]  # fmt: skip
+
+    def _gathered(self, out: list[np.ndarray]):
+        """The kernel's outputs as (nodal force, PlasticState); flagged cells raise."""
+        kin = self.kin
+        fe, cp_inv, eqps, tau, J, wp, wv, flags = out
+        if np.any(flags):
+            bad = np.nonzero(flags)[0]
+            cell = int(bad[0])
+            if flags[cell] == 1:
+                raise InvertedElementError(
+                    f"inverted or degenerate cell {cell}: det F <= 0 ({bad.size} such cells)"
+                )
+            raise StateError(f"J2 return map not converged in cell {cell}")
+        f = np.bincount(kin.cell_dofs.ravel(), weights=fe.ravel(), minlength=kin.n_dofs)
+        return f, PlasticState(cp_inv, eqps, tau, J, wp, wv)
+
+    # ------------------------------------------------------------------ post-processing
+    def stored_energy(self, u: np.ndarray, state: PlasticState, weight: WeightLike = None) -> float:
+        """Elastic stored energy Σ w₀ ψ(ε_e) of a committed state at ``u`` (J)."""
+        alpha = self.elastic.weight_at_quadrature(weight)
+        trial = self.kin.trial_elastic_stretch(u, state.cp_inv, self.fbar)
+        dev = hencky_strain(trial.B, self.dim == 2, minus_identity=True)[0]
+        tr = trial.log_volume
+        K, G = self.material.bulk_modulus, self.material.shear_modulus
+        psi = 0.5 * K * tr**2 + G * np.sum(dev**2, axis=0)
+        return float(np.sum(alpha * self.kin.dv0 * psi))
+
+    def stored_energy_of_state(self, state: PlasticState, weight: WeightLike = None) -> float:
+        """Elastic stored energy Σ w₀ ψ (J) from a state's own Kirchhoff stress: for the Hencky
+        law τ = K ln J 1 + 2G dev ε_e, so ψ = (tr τ)²/(18 K) + ‖dev τ‖²/(4 G).
+
+        The same as :meth:`stored_energy` at the displacement the state was evaluated at (to
+        round-off), without recomputing the kinematics: a product per quadrature point.
+
+        Raises
+        ------
+        ValueError
+            With bulk viscosity, whose pressure the state's τ includes.
+        """
+        if self.bulk_viscosity:
+            raise ValueError("stored_energy_of_state: the state's Kirchhoff stress includes the "
+                             "bulk viscosity's pressure; use stored_energy(u, state)")  # fmt: skip
+        alpha = self.elastic.weight_at_quadrature(weight)
+        tau = state.kirchhoff
+        tr = tau[0, 0] + tau[1, 1] + tau[2, 2]
+        dev2 = np.einsum("ij...,ij...->...", tau, tau) - tr**2 / 3.0
+        K, G = self.material.bulk_modulus, self.material.shear_modulus
+        psi = tr**2 / (18.0 * K) + dev2 / (4.0 * G)
+        return float(np.sum(alpha * self.kin.dv0 * psi))
+
+    def plastic_dissipation(self, state: PlasticState, weight: WeightLike = None) -> float:
+        """Accumulated plastic work Σ w₀ w_p (J)."""
+        alpha = self.elastic.weight_at_quadrature(weight)
+        return float(np.sum(alpha * self.kin.dv0 * state.plastic_work))
+
+    def viscous_dissipation(self, state: PlasticState, weight: WeightLike = None) -> float:
+        """Accumulated work of the bulk viscosity Σ w₀ w_v (J)."""
+        alpha = self.elastic.weight_at_quadrature(weight)
+        return float(np.sum(alpha * self.kin.dv0 * state.viscous_work))
+
+    def critical_time_step(self, u: np.ndarray, state: PlasticState | None = None) -> float:
+        """Estimate (s) of the explicit critical step in the configuration X + u.
+
+        min over the cells of κ_c h_c(u)/c_d, with h_c the cell's measure over its longest edge
+        (its thickness) and κ_c calibrated once per cell so that at u = 0 the estimate is the
+        element eigenvalue bound of :func:`~arlequin.models.elastic.element_critical_step` (a
+        lower bound of the critical step). Cheap enough to follow, every few steps, the cells
+        crushed during a run. Capability ``"critical_time_step"``.
+        """
+        cd = self.material.dilatational_wave_speed
+        if self._critical_ratio is None:
+            per_cell = element_critical_step(self.elastic, self.elastic.basis, per_cell=True)
+            self._critical_ratio = per_cell * cd / self.kin.cell_sizes(self.mesh.p)
+        h = self.kin.cell_sizes(self.current_coordinates(u))
+        return float(np.min(self._critical_ratio * h) / cd)
+
+    def current_coordinates(self, u: np.ndarray) -> np.ndarray:
+        """Node positions x = X + u, shape (dim, n_nodes) (m)."""
+        return self.mesh.p + np.asarray(u)[self.kin.dofs]

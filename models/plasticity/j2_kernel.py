@@ -1,0 +1,427 @@
+"""The compiled kernel of finite-strain J2 on planar Q1 cells (axisymmetric, plane strain).
+
+One fused pass per cell, parallel over the cells (numba ``prange``): deformation gradient at
+the four Gauss points, the cell's mean dilatation (F-bar), the exponential-map return of
+:mod:`arlequin.models.plasticity.j2` (closed-form principal axes in the (r, z) plane plus the hoop
+or out-of-plane axis), the optional bulk viscosity, and the consistent internal force of
+:mod:`arlequin.models.plasticity.kinematics`, written into preallocated per-cell buffers (no race:
+the nodal forces are summed afterwards with ``np.bincount``). It is the numpy reference path
+computed point by point, compared with it to 1e-12 (``tests/test_j2_kernel.py``).
+
+Hardening laws by code (see :mod:`arlequin.models.plasticity.hardening`): 0 linear (σ_y0, H), 1 Voce
+(σ_y0, Q, b, H), 2 Johnson–Cook (A, B, n, C, ε̄̇0, ε̄p floor).
+
+numba compiles on first call (cached on disk, ``cache=True``); benchmarks count the first call
+out of their figures.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+__all__ = ["planar_j2_kernel", "scratch", "warm_up"]
+
+SQRT23 = math.sqrt(2.0 / 3.0)
+
+
+@nb.njit(cache=True, inline="always", error_model="numpy")
+def _flow(code, prm, e, rate):
+    if code == 0:
+        return prm[0] + prm[1] * e
+    if code == 1:
+        return prm[0] + prm[1] * (1.0 - math.exp(-prm[2] * e)) + prm[3] * e
+    ee = e if e > 0.0 else 0.0
+    factor = 1.0
+    if prm[3] > 0.0 and rate > prm[4]:
+        factor = 1.0 + prm[3] * math.log(rate / prm[4])
+    return (prm[0] + prm[1] * ee ** prm[2]) * factor
+
+
+@nb.njit(cache=True, inline="always", error_model="numpy")
+def _slope(code, prm, e, rate):
+    if code == 0:
+        return prm[1]
+    if code == 1:
+        return prm[1] * prm[2] * math.exp(-prm[2] * e) + prm[3]
+    ee = e if e > prm[5] else prm[5]
+    factor = 1.0
+    if prm[3] > 0.0 and rate > prm[4]:
+        factor = 1.0 + prm[3] * math.log(rate / prm[4])
+    return prm[2] * prm[1] * ee ** (prm[2] - 1.0) * factor
+
+
+@nb.njit(cache=True, inline="always", error_model="numpy")
+def _rate_slope(code, prm, e, rate):
+    if code != 2 or prm[3] == 0.0 or rate <= prm[4]:
+        return 0.0
+    ee = e if e > 0.0 else 0.0
+    return (prm[0] + prm[1] * ee ** prm[2]) * prm[3] / rate
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _plastic_multiplier(norm, eqps, code, prm, G, dt):
+    """Δγ of the consistency equation: safeguarded Newton, as
+    arlequin.models.plasticity.j2._consistency."""
+    h0 = _slope(code, prm, eqps, 0.0)
+    dg = (norm - SQRT23 * _flow(code, prm, eqps, 0.0)) / (2.0 * G + 2.0 / 3.0 * h0)
+    if code == 0:
+        return dg
+    scale = SQRT23 * _flow(code, prm, eqps, 0.0)
+    rated = dt > 0.0 and code == 2 and prm[3] > 0.0
+    lo = 0.0
+    hi = norm / (2.0 * G)
+    dg = min(max(dg, 0.0), hi)
+    step_old = hi - lo
+    step = step_old
+    for _ in range(50):
+        e = eqps + SQRT23 * dg
+        rate = SQRT23 * dg / dt if rated else 0.0
+        r = norm - 2.0 * G * dg - SQRT23 * _flow(code, prm, e, rate)
+        if abs(r) <= 1e-12 * scale or hi - lo <= 1e-15 * hi:
+            return dg
+        if r > 0.0:
+            lo = dg
+        elif r < 0.0:
+            hi = dg
+        dr = -2.0 * G - 2.0 / 3.0 * _slope(code, prm, e, rate)
+        if rated:
+            dr -= (2.0 / 3.0) / dt * _rate_slope(code, prm, e, rate)
+        newton = dg - r / dr
+        step_old_now = step
+        if (newton > lo and newton < hi) and abs(2.0 * r) <= abs(step_old * dr):
+            step = abs(r / dr)
+            dg = newton
+        else:
+            step = 0.5 * (hi - lo)
+            dg = 0.5 * (lo + hi)
+        step_old = step_old_now
+    return -1.0  # not converged: flagged by the caller
+
+
+@nb.njit(parallel=True, cache=True, error_model="numpy", fastmath={"contract"})
+def planar_j2_kernel(
+    u, cell_dofs, grad, val, radius, dv0, alpha, axi, fbar, K, G, code, prm, dt,
+    cp_inv, eqps, wp, wv, jac_old, visc, h0, scratch_h, scratch_g, scratch_u,
+    fe, cp_new, eqps_new, tau_out, j_out, wp_new, wv_new, flags,
+):  # fmt: skip
+    """One evaluation on every cell (see the module docstring).
+
+    Inputs: u (n_dofs,) displacement; cell_dofs (2, nen, ne); grad (nen, 2, ne, nq); val
+    (nen, ne, nq); radius (ne, nq) (ones in plane strain); dv0, alpha (ne, nq); axi, fbar (bool);
+    K, G (Pa); code, prm (6,) the hardening law; dt (s, ≤ 0: rates off); the committed state
+    cp_inv (3, 3, ne, nq), eqps, wp, wv, jac_old (ne, nq); visc (4,) = (c_linear, c_quadratic,
+    ρ₀, c_d) of the bulk viscosity (ρ₀ = 0: off), h0 (ne,) reference cell lengths:
+    q = ρ (c_quad ℓ² ε̇_v² − c_lin ℓ c_d ε̇_v) on compression (ε̇_v < 0), ρ = ρ₀/J̄, ℓ = h0 √J̄.
+    Scratch (overwritten, one slot per thread, no allocation per cell): scratch_h
+    (n_threads, nq, 6), scratch_g (n_threads, nq, nen, 3), scratch_u (n_threads, 2, nen).
+    Outputs (overwritten): fe (2, nen, ne) cell forces, cp_new, tau_out (3, 3, ne, nq),
+    eqps_new, j_out, wp_new, wv_new (ne, nq), flags (ne,): 1 inverted cell, 2 return map not
+    converged.
+    """
+    ne = grad.shape[0]
+    nq = grad.shape[1]
+    nen = grad.shape[2]
+    third = 1.0 / 3.0
+    for e in nb.prange(ne):
+        flags[e] = 0
+        tid = nb.get_thread_id()
+        hs = scratch_h[tid]  # per qp: h00, h01, h10, h11, hθ = F − 1, J − 1
+        gs = scratch_g[tid]  # per qp and node: ∇ₓN_a (2) and N_a / r
+        # ---- H = F − 1 at the Gauss points (kept apart from 1 for small strains), J, J̄
+        vol0 = 0.0
+        volj_m1 = 0.0
+        volj_old = 0.0
+        us = scratch_u[tid]
+        for a in range(nen):
+            us[0, a] = u[cell_dofs[e, a, 0]]
+            us[1, a] = u[cell_dofs[e, a, 1]]
+        for q in range(nq):
+            h00 = 0.0
+            h01 = 0.0
+            h10 = 0.0
+            h11 = 0.0
+            ur = 0.0
+            for a in range(nen):
+                ur_a = us[0, a]
+                uz_a = us[1, a]
+                g0 = grad[e, q, a, 0]
+                g1 = grad[e, q, a, 1]
+                h00 += ur_a * g0
+                h01 += ur_a * g1
+                h10 += uz_a * g0
+                h11 += uz_a * g1
+                ur += ur_a * val[e, q, a]
+            hth = ur / radius[e, q] if axi else 0.0
+            j2m1 = h00 + h11 + h00 * h11 - h01 * h10
+            jm1 = j2m1 + hth + j2m1 * hth
+            hs[q, 0] = h00
+            hs[q, 1] = h01
+            hs[q, 2] = h10
+            hs[q, 3] = h11
+            hs[q, 4] = hth
+            hs[q, 5] = jm1
+            if not (1.0 + jm1 > 0.0):
+                flags[e] = 1
+            vol0 += dv0[e, q]
+            volj_m1 += jm1 * dv0[e, q]
+            volj_old += jac_old[e, q] * dv0[e, q]
+        if flags[e] != 0:
+            for i in range(2):
+                for a in range(nen):
+                    fe[i, a, e] = 0.0
+            continue
+        jbar_m1 = volj_m1 / vol0
+        jbar = 1.0 + jbar_m1
+        lnjbar = math.log1p(jbar_m1)
+        volj = jbar * vol0
+        # ---- bulk viscosity: a pressure q on compression (Kirchhoff −J q 1)
+        qv = 0.0
+        jbar_old = volj_old / vol0
+        if visc[2] > 0.0 and dt > 0.0:
+            rate = (jbar - jbar_old) / (dt * jbar)  # volumetric strain rate (1/s)
+            if rate < 0.0:  # compression only
+                ell = h0[e] * math.sqrt(jbar)
+                rho = visc[2] / jbar
+                qv = rho * (visc[1] * ell * ell * rate * rate - visc[0] * ell * visc[3] * rate)
+        # ---- spatial gradients and the J-weighted cell average of the divergences
+        dm0_0 = 0.0
+        dm0_1 = 0.0
+        dm0_2 = 0.0
+        dm0_3 = 0.0
+        dm1_0 = 0.0
+        dm1_1 = 0.0
+        dm1_2 = 0.0
+        dm1_3 = 0.0
+        for q in range(nq):
+            f00 = 1.0 + hs[q, 0]
+            f11 = 1.0 + hs[q, 3]
+            idet = 1.0 / (f00 * f11 - hs[q, 1] * hs[q, 2])
+            i00 = f11 * idet
+            i01 = -hs[q, 1] * idet
+            i10 = -hs[q, 2] * idet
+            i11 = f00 * idet
+            jw = (1.0 + hs[q, 5]) * dv0[e, q]
+            rinv = 1.0 / (radius[e, q] * (1.0 + hs[q, 4])) if axi else 0.0
+            for a in range(nen):
+                g0 = grad[e, q, a, 0]
+                g1 = grad[e, q, a, 1]
+                x0 = g0 * i00 + g1 * i10
+                x1 = g0 * i01 + g1 * i11
+                hp = val[e, q, a] * rinv
+                gs[q, a, 0] = x0
+                gs[q, a, 1] = x1
+                gs[q, a, 2] = hp
+                d0 = (x0 + hp) * jw
+                d1 = x1 * jw
+                if a == 0:
+                    dm0_0 += d0
+                    dm1_0 += d1
+                elif a == 1:
+                    dm0_1 += d0
+                    dm1_1 += d1
+                elif a == 2:
+                    dm0_2 += d0
+                    dm1_2 += d1
+                else:
+                    dm0_3 += d0
+                    dm1_3 += d1
+        ivolj = 1.0 / volj
+        dm0_0 *= ivolj
+        dm0_1 *= ivolj
+        dm0_2 *= ivolj
+        dm0_3 *= ivolj
+        dm1_0 *= ivolj
+        dm1_1 *= ivolj
+        dm1_2 *= ivolj
+        dm1_3 *= ivolj
+        for i in range(2):
+            for a in range(nen):
+                fe[i, a, e] = 0.0
+        # ---- return map and forces at each Gauss point
+        for q in range(nq):
+            h00 = hs[q, 0]
+            h01 = hs[q, 1]
+            h10 = hs[q, 2]
+            h11 = hs[q, 3]
+            hth = hs[q, 4]
+            jm1 = hs[q, 5]
+            jq = 1.0 + jm1
+            # B = F C_p⁻¹ Fᵀ − 1 = H + Hᵀ + H Hᵀ + F D Fᵀ, D = C_p⁻¹ − 1 (in-plane block, third
+            # axis); F-bar only rescales it: the volumetric strain is ln J̄ (ln J without)
+            b00 = 1.0 + h00
+            b11 = 1.0 + h11
+            b22 = 1.0 + hth
+            c00 = cp_inv[0, 0, e, q] - 1.0
+            c01 = cp_inv[0, 1, e, q]
+            c11 = cp_inv[1, 1, e, q] - 1.0
+            c22 = cp_inv[2, 2, e, q] - 1.0
+            t00 = b00 * c00 + h01 * c01
+            t01 = b00 * c01 + h01 * c11
+            t10 = h10 * c00 + b11 * c01
+            t11 = h10 * c01 + b11 * c11
+            e00 = 2.0 * h00 + h00 * h00 + h01 * h01 + t00 * b00 + t01 * h01
+            e01 = h01 + h10 + h00 * h10 + h01 * h11 + t00 * h10 + t01 * b11
+            e11 = 2.0 * h11 + h10 * h10 + h11 * h11 + t10 * h10 + t11 * b11
+            e22 = 2.0 * hth + hth * hth + b22 * c22 * b22
+            # in-plane eigenpairs: μ = mean ± rad, axes at angle θ with cos 2θ = (e00 − e11)/2rad
+            mean = 0.5 * (e00 + e11)
+            half = 0.5 * (e00 - e11)
+            rad = math.sqrt(half * half + e01 * e01)
+            if rad > 0.0:
+                irad = 1.0 / rad
+                c2t = half * irad
+                s2t = e01 * irad
+            else:
+                c2t = 1.0
+                s2t = 0.0
+            cc = 0.5 * (1.0 + c2t)  # cos²θ
+            ss = 0.5 * (1.0 - c2t)  # sin²θ
+            cs = 0.5 * s2t  # cos θ sin θ
+            l1 = mean + rad
+            l2 = mean - rad
+            if not (l2 > -1.0 and e22 > -1.0):
+                flags[e] = 1
+                continue
+            # deviatoric Hencky strains from the log-ratios ½ ln(λ_i²/λ_3²)
+            i3 = 1.0 / (1.0 + e22)
+            ra = 0.5 * math.log1p((l1 - e22) * i3)
+            rb = 0.5 * math.log1p((l2 - e22) * i3)
+            d1 = (2.0 * ra - rb) * third
+            d2 = (2.0 * rb - ra) * third
+            d3 = -(ra + rb) * third
+            tr = lnjbar if fbar else math.log1p(jm1)
+            norm = 2.0 * G * math.sqrt(d1 * d1 + d2 * d2 + d3 * d3)
+            ep = eqps[e, q]
+            fy = norm - SQRT23 * _flow(code, prm, ep, 0.0)
+            dg = 0.0
+            if fy > 0.0:
+                dg = _plastic_multiplier(norm, ep, code, prm, G, dt)
+                if dg < 0.0:
+                    flags[e] = 2
+                    dg = 0.0
+            # radial return: the deviator shrinks by 1 − 2GΔγ/‖s_trial‖
+            shrink = 1.0 - 2.0 * G * dg / norm if (norm > 0.0 and dg > 0.0) else 1.0
+            dep = SQRT23 * dg
+            eqps_new[e, q] = ep + dep
+            wrk = 0.0
+            if dg > 0.0:
+                rate = dep / dt if dt > 0.0 else 0.0
+                wrk = _flow(code, prm, ep + dep, rate) * dep
+            wp_new[e, q] = wp[e, q] + wrk
+            s1 = K * tr + 2.0 * G * shrink * d1
+            s2 = K * tr + 2.0 * G * shrink * d2
+            s3 = K * tr + 2.0 * G * shrink * d3
+            # back to (r, z): principal directions (cos θ, sin θ) and (−sin θ, cos θ)
+            tau00 = s1 * cc + s2 * ss
+            tau11 = s1 * ss + s2 * cc
+            tau01 = (s1 - s2) * cs
+            tau22 = s3
+            if dg > 0.0:
+                # C_p⁻¹ = F̄⁻¹ b̄_e F̄⁻ᵀ = F⁻¹ (b̄_e / s²) F⁻ᵀ, b̄_e/s² of log-eigenvalues
+                # 2(ε_i − ln s) = 2(ln J / 3 + shrink d_i)
+                lj = math.log1p(jm1) * third
+                x1 = math.exp(2.0 * (lj + shrink * d1))
+                x2 = math.exp(2.0 * (lj + shrink * d2))
+                be00 = x1 * cc + x2 * ss
+                be11 = x1 * ss + x2 * cc
+                be01 = (x1 - x2) * cs
+                be22 = math.exp(2.0 * (lj + shrink * d3))
+                idetb = 1.0 / (b00 * b11 - h01 * h10)
+                n00 = b11 * idetb
+                n01 = -h01 * idetb
+                n10 = -h10 * idetb
+                n11 = b00 * idetb
+                u00 = n00 * be00 + n01 * be01
+                u01 = n00 * be01 + n01 * be11
+                u10 = n10 * be00 + n11 * be01
+                u11 = n10 * be01 + n11 * be11
+                cp_new[0, 0, e, q] = u00 * n00 + u01 * n01
+                cp_new[0, 1, e, q] = u00 * n10 + u01 * n11
+                cp_new[1, 0, e, q] = cp_new[0, 1, e, q]
+                cp_new[1, 1, e, q] = u10 * n10 + u11 * n11
+                cp_new[2, 2, e, q] = be22 / (b22 * b22)
+            else:  # elastic: C_p⁻¹ kept bit for bit
+                cp_new[0, 0, e, q] = cp_inv[0, 0, e, q]
+                cp_new[0, 1, e, q] = cp_inv[0, 1, e, q]
+                cp_new[1, 0, e, q] = cp_inv[1, 0, e, q]
+                cp_new[1, 1, e, q] = cp_inv[1, 1, e, q]
+                cp_new[2, 2, e, q] = cp_inv[2, 2, e, q]
+            cp_new[0, 2, e, q] = 0.0
+            cp_new[2, 0, e, q] = 0.0
+            cp_new[1, 2, e, q] = 0.0
+            cp_new[2, 1, e, q] = 0.0
+            tau_out[0, 0, e, q] = tau00
+            tau_out[1, 1, e, q] = tau11
+            tau_out[0, 1, e, q] = tau01
+            tau_out[1, 0, e, q] = tau01
+            tau_out[2, 2, e, q] = tau22
+            tau_out[0, 2, e, q] = 0.0
+            tau_out[2, 0, e, q] = 0.0
+            tau_out[1, 2, e, q] = 0.0
+            tau_out[2, 1, e, q] = 0.0
+            j_out[e, q] = jq
+            wv_new[e, q] = wv[e, q] + qv * (jbar_old - jbar)
+            # forces: material stress plus the viscous pressure
+            w0 = alpha[e, q] * dv0[e, q]
+            pv = jq * qv
+            tau00 -= pv
+            tau11 -= pv
+            tau22 -= pv
+            p = (tau00 + tau11 + tau22) * third
+            for a in range(nen):
+                ga0 = gs[q, a, 0]
+                ga1 = gs[q, a, 1]
+                hp = gs[q, a, 2]
+                f0 = tau00 * ga0 + tau01 * ga1 + tau22 * hp
+                f1 = tau01 * ga0 + tau11 * ga1
+                if fbar:
+                    if a == 0:
+                        dmr = dm0_0
+                        dmz = dm1_0
+                    elif a == 1:
+                        dmr = dm0_1
+                        dmz = dm1_1
+                    elif a == 2:
+                        dmr = dm0_2
+                        dmz = dm1_2
+                    else:
+                        dmr = dm0_3
+                        dmz = dm1_3
+                    f0 += p * (dmr - ga0 - hp)
+                    f1 += p * (dmz - ga1)
+                fe[0, a, e] += w0 * f0
+                fe[1, a, e] += w0 * f1
+    return 0
+
+
+def scratch(n_qp: int = 4, nen: int = 4) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per-thread scratch buffers of :func:`planar_j2_kernel` (small: they stay in cache)."""
+    n = nb.config.NUMBA_NUM_THREADS
+    return np.empty((n, n_qp, 6)), np.empty((n, n_qp, nen, 3)), np.empty((n, 2, nen))
+
+
+def warm_up() -> None:
+    """Compile (or load from the cache) the kernel on a one-cell problem."""
+    nen, ne, nq = 4, 1, 4
+    grad = np.zeros((ne, nq, nen, 2))
+    grad[..., 0] = np.array([-1.0, 1.0, 1.0, -1.0])
+    grad[..., 1] = np.array([-1.0, -1.0, 1.0, 1.0])
+    ones = np.ones((ne, nq))
+    zeros = np.zeros((ne, nq))
+    cp = np.broadcast_to(np.eye(3)[:, :, None, None], (3, 3, ne, nq)).copy()
+    dofs = np.arange(2 * nen).reshape(ne, nen, 2)
+    out = [np.zeros((2, nen, ne)), np.zeros((3, 3, ne, nq)), np.zeros((ne, nq)),
+           np.zeros((3, 3, ne, nq)), np.zeros((ne, nq)), np.zeros((ne, nq)), np.zeros((ne, nq)),
+           np.zeros(ne, dtype=np.int64)]  # fmt: skip
+    # the weight as FiniteStrainJ2 passes it, a read-only broadcast view: numba types it
+    # apart from a writeable array, and a writeable one here left each process's first run
+    # compiling (or loading) its own specialisation inside its clock
+    weight = np.broadcast_to(ones, ones.shape)
+    planar_j2_kernel(
+        np.zeros(2 * nen), dofs, grad, np.full((ne, nq, nen), 0.25), ones, ones, weight,
+        True, True, 1.0, 1.0, 0, np.array([1.0, 0.0, 0.0, 0.0, 0.0, 0.0]), 0.0, cp, zeros,
+        zeros, zeros, ones, np.zeros(4), np.ones(ne), *scratch(nq, nen), *out,
+    )  # fmt: skip
