@@ -51,6 +51,37 @@ def _map_models_folder() -> None:
 
 _map_models_folder()
 
+
+def numba_cache_dir() -> str:
+    """Where numba keeps the compiled kernels of this package (``cache=True``): the
+    ``NUMBA_CACHE_DIR`` environment variable if set, else a per-user cache directory,
+    ``$XDG_CACHE_HOME/arlequin/numba`` (``~/.cache/arlequin/numba`` by default).
+
+    Never inside the installed package: a cache there outlives ``pip uninstall`` (the
+    leftover folder then shadows ``arlequin.models`` of the next installation) and cannot be
+    written in a read-only installation. numba keeps one subfolder per source folder, so
+    several installations share the directory without clashing.
+    """
+    import os
+
+    given = os.environ.get("NUMBA_CACHE_DIR")
+    if given:
+        return given
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return os.path.join(base, "arlequin", "numba")
+
+
+def _cache_kernels_outside_the_package() -> None:
+    """Point numba's cache at :func:`numba_cache_dir` before any kernel of the package is
+    compiled (the kernels' modules are imported after this package's ``__init__``)."""
+    import numba
+
+    if not numba.config.CACHE_DIR:
+        numba.config.CACHE_DIR = numba_cache_dir()
+
+
+_cache_kernels_outside_the_package()
+
 from .contract import (
     CapabilityError,
     ConstraintError,

@@ -30,7 +30,7 @@ def test_core_never_imports_the_models():
     offenders = []
     for path in ROOT.rglob("*.py"):
         rel = path.relative_to(ROOT)
-        if rel.parts[0] in ("demos",) or rel.name == "cli.py":
+        if rel.parts[0] in ("demos", "cli"):
             continue
         for name in _imports(path):
             if "models" in name.split("."):
@@ -145,3 +145,31 @@ def test_progress_bar_shows_in_a_terminal():
     os.close(master)
     text = out.decode("utf-8", "replace")
     assert "simulated time" in text and "3.0/3.0 µs" in text and "100%" in text
+
+
+def test_numba_caches_the_kernels_outside_the_package(tmp_path):
+    """The compiled kernels' cache lives in the per-user cache directory (or NUMBA_CACHE_DIR),
+    never in the installed package (a leftover cache folder there shadowed ``arlequin.models``
+    after an uninstall, and a read-only installation could not write it)."""
+    code = (
+        "import arlequin\n"
+        "from arlequin.models.plasticity import j2_kernel\n"
+        "from arlequin.geometry import clip3d\n"
+        "print(j2_kernel.planar_j2_kernel._cache._cache_path)\n"
+        "print(clip3d._clip_one._cache._cache_path)\n"
+    )
+    env = {k: v for k, v in __import__("os").environ.items() if k != "NUMBA_CACHE_DIR"}
+    env["XDG_CACHE_HOME"] = str(tmp_path)
+    r = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, env=env, check=False
+    )
+    assert r.returncode == 0, r.stderr
+    for line in r.stdout.split():
+        path = Path(line).resolve()
+        assert path.is_relative_to(tmp_path / "arlequin" / "numba"), path
+        assert not path.is_relative_to(ROOT.parent), path
+    env["NUMBA_CACHE_DIR"] = str(tmp_path / "given")
+    r = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, env=env, check=False
+    )
+    assert all(Path(p).is_relative_to(tmp_path / "given") for p in r.stdout.split()), r.stdout

@@ -173,36 +173,14 @@ def _solve(cls, system, t_end, dt, n_steps, t0, u0, v0, t_eval, step_controller,
            record_every, save_fields, on_record, on_step, on_checkpoint, restore,
            options) -> DynamicResult:  # fmt: skip
     """:func:`solve` with the integrator's class resolved."""
-    known = options_of(cls)
-    unknown = sorted(set(options) - set(known))
-    if unknown:
-        raise ValueError(
-            f"unknown option(s) {unknown} for the {cls.name!r} scheme ({cls.__name__}); its "
-            f"options are {[k for k in known if k not in ('t0', 'u0', 'v0', 'dt')]}"
-        )
+    _check_options(cls, options)
     if t_end is None and n_steps is None and t_eval is not None:
         t_end = float(np.max(np.asarray(t_eval, dtype=float)))
-    if (t_end is None) == (n_steps is None):
-        raise ValueError("give exactly one of t_end (s) or n_steps")
-    if int(record_every) != record_every or record_every < 1:
-        raise ValueError(f"record_every must be a positive integer, got {record_every}")
-    t0 = float(t0)
-    if t_end is not None:
-        t_end = float(t_end)
-        if not (math.isfinite(t_end) and t_end > t0):
-            raise ValueError(f"t_end must be finite and exceed t0, got t_end={t_end}, t0={t0}")
-    else:
-        if int(n_steps) != n_steps or n_steps < 1:
-            raise ValueError(f"n_steps must be a positive integer, got {n_steps}")
-        n_steps = int(n_steps)
+    t0, t_end, n_steps = _check_span(t0, t_end, n_steps, record_every)
     times = _check_t_eval(t_eval, t0, t_end) if t_eval is not None else None
     integ = cls(system, dt, t0=t0, u0=u0, v0=v0, step_controller=step_controller, **options)
     if t_end is not None and isinstance(integ.controller, FixedStep):
-        steps = max(1, math.ceil((t_end - t0) / integ.dt * (1.0 - 1e-12)))
-        dt_run = (t_end - t0) / steps
-        if abs(dt_run - integ.dt) > 1e-14 * integ.dt:
-            integ.controller = FixedStep(dt_run)
-            integ.set_step_size(dt_run)
+        _land_on_end(integ, t0, t_end)
     stops: list[float] = []
     if times is not None:
         stops += times[times > t0].tolist()
@@ -225,39 +203,106 @@ def _solve(cls, system, t_end, dt, n_steps, t0, u0, v0, t_eval, step_controller,
         if callback is not None and callback(integ):
             return rec.result(1, "stopped by the callback at the initial state")
         t_start = t0
-    pending = list(times[times > t_start + 1e-12 * float(integ.dt)]) if times is not None \
-        else None  # fmt: skip
-    k = integ.step_count
-    verbose = logger.isEnabledFor(logging.INFO)
-    next_log = time.perf_counter() + LOG_INTERVAL
-    while True:
-        if n_steps is not None and k >= n_steps:
-            break
-        if t_end is not None and integ.status == "finished":
-            break
+    pending = None
+    if times is not None:
+        pending = list(times[times > t_start + 1e-12 * float(integ.dt)])
+    loop = _Loop(integ, rec, n_steps, t_end, record_every, pending, callback, on_step,
+                 on_checkpoint)  # fmt: skip
+    return loop.run()
+
+
+def _check_options(cls, options) -> None:
+    """Refuse options the integrator class does not take (named, with the known ones)."""
+    known = options_of(cls)
+    unknown = sorted(set(options) - set(known))
+    if unknown:
+        raise ValueError(
+            f"unknown option(s) {unknown} for the {cls.name!r} scheme ({cls.__name__}); its "
+            f"options are {[k for k in known if k not in ('t0', 'u0', 'v0', 'dt')]}"
+        )
+
+
+def _check_span(t0, t_end, n_steps, record_every) -> tuple[float, float | None, int | None]:
+    """The run's span checked: ``(t0, t_end, n_steps)``, exactly one of the last two given."""
+    if (t_end is None) == (n_steps is None):
+        raise ValueError("give exactly one of t_end (s) or n_steps")
+    if int(record_every) != record_every or record_every < 1:
+        raise ValueError(f"record_every must be a positive integer, got {record_every}")
+    t0 = float(t0)
+    if t_end is not None:
+        t_end = float(t_end)
+        if not (math.isfinite(t_end) and t_end > t0):
+            raise ValueError(f"t_end must be finite and exceed t0, got t_end={t_end}, t0={t0}")
+    else:
+        if int(n_steps) != n_steps or n_steps < 1:
+            raise ValueError(f"n_steps must be a positive integer, got {n_steps}")
+        n_steps = int(n_steps)
+    return t0, t_end, n_steps
+
+
+def _land_on_end(integ, t0: float, t_end: float) -> None:
+    """A fixed step shortened (at most) so that a whole number of steps lands on ``t_end``."""
+    steps = max(1, math.ceil((t_end - t0) / integ.dt * (1.0 - 1e-12)))
+    dt_run = (t_end - t0) / steps
+    if abs(dt_run - integ.dt) > 1e-14 * integ.dt:
+        integ.controller = FixedStep(dt_run)
+        integ.set_step_size(dt_run)
+
+
+class _Loop:
+    """The time loop of :func:`solve`: step, notify, record (at ``t_eval`` times or every
+    ``record_every`` steps), checkpoint, ask the callback; until the end or a stop."""
+
+    def __init__(self, integ, rec, n_steps, t_end, record_every, pending, callback, on_step,
+                 on_checkpoint) -> None:  # fmt: skip
+        self.integ, self.rec = integ, rec
+        self.n_steps, self.t_end, self.record_every = n_steps, t_end, record_every
+        self.pending, self.callback = pending, callback
+        self.on_step, self.on_checkpoint = on_step, on_checkpoint
+
+    def _done(self, k: int) -> bool:
+        if self.n_steps is not None and k >= self.n_steps:
+            return True
+        return self.t_end is not None and self.integ.status == "finished"
+
+    def _step(self) -> None:
+        integ = self.integ
         try:
             integ.step()
         except SimulationError as err:
             integ.status = "failed"
-            err.result = rec.result(-1, str(err))
+            err.result = self.rec.result(-1, str(err))
             raise
-        k += 1
-        for listener in on_step:
-            listener(integ)
-        if verbose and time.perf_counter() >= next_log:
-            _log_progress(integ)
-            next_log = time.perf_counter() + LOG_INTERVAL
-        last = integ.status == "finished" or (n_steps is not None and k == n_steps)
-        if pending is not None:
-            take = bool(pending) and integ.t >= pending[0] - 1e-12 * float(integ.step_size)
-            if take:
-                pending.pop(0)
-        else:
-            take = k % record_every == 0 or last
+
+    def _take(self, k: int) -> bool:
+        """Whether step ``k`` is recorded."""
+        integ = self.integ
+        last = integ.status == "finished" or (self.n_steps is not None and k == self.n_steps)
+        if self.pending is None:
+            return k % self.record_every == 0 or last
+        take = bool(self.pending) and integ.t >= self.pending[0] - 1e-12 * float(integ.step_size)
         if take:
+            self.pending.pop(0)
+        return take
+
+    def run(self) -> DynamicResult:
+        integ, rec = self.integ, self.rec
+        k = integ.step_count
+        verbose = logger.isEnabledFor(logging.INFO)
+        next_log = time.perf_counter() + LOG_INTERVAL
+        while not self._done(k):
+            self._step()
+            k += 1
+            for listener in self.on_step:
+                listener(integ)
+            if verbose and time.perf_counter() >= next_log:
+                _log_progress(integ)
+                next_log = time.perf_counter() + LOG_INTERVAL
+            if not self._take(k):
+                continue
             rec.record()
-            if on_checkpoint is not None:
-                on_checkpoint(integ, rec)
-            if callback is not None and callback(integ):
+            if self.on_checkpoint is not None:
+                self.on_checkpoint(integ, rec)
+            if self.callback is not None and self.callback(integ):
                 return rec.result(1, f"stopped by the callback at step {k}, t = {integ.t:.6e} s")
-    return rec.result(0, f"reached t = {integ.t:.6e} s in {integ.step_count} steps")
+        return rec.result(0, f"reached t = {integ.t:.6e} s in {integ.step_count} steps")
