@@ -56,7 +56,7 @@ class StudySpec:
 
 
 def _subparser(demo: str):
-    from ..cli.demos import demo_parser
+    from ...cli.demos import demo_parser
 
     return demo_parser()[1][demo]
 
@@ -128,7 +128,7 @@ def _check_case(demo: str, params: Mapping[str, Any], parser) -> None:
 
 def _check_ranges(demo: str, params: Mapping[str, Any], parser) -> None:
     """The demo's own input checks on the case's parsed command line (before any case runs)."""
-    from ..cli.demos import check_case
+    from ...cli.demos import check_case
 
     args = parser.parse_args(_argv(demo, params, parser)[1:])
     try:
