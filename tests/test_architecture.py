@@ -17,6 +17,8 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
+import pytest
+
 import arlequin
 
 ROOT = Path(arlequin.__file__).resolve().parent  # arlequin/
@@ -104,16 +106,32 @@ def test_models_import_only_the_contract_and_pure_helpers():
     assert not bad, bad
 
 
-def test_integrators_do_not_import_the_results_layer_or_the_problem():
+#: Each layer of the core and what it may import from the package besides itself (the table of
+#: docs/architecture.md).
+LAYERS = {
+    "arlequin.contract": (),
+    "arlequin.dofs": ("arlequin.contract",),
+    "arlequin.geometry": ("arlequin.contract",),
+    "arlequin.coupling": ("arlequin.contract", "arlequin.dofs", "arlequin.geometry"),
+    "arlequin.problem": (
+        "arlequin.contract",
+        "arlequin.dofs",
+        "arlequin.geometry",
+        "arlequin.coupling",
+        "arlequin.io.layout",
+    ),
+    "arlequin.solvers": ("arlequin.contract", "arlequin.dofs", "arlequin.problem.system"),
+}
+
+
+@pytest.mark.parametrize("layer", sorted(LAYERS))
+def test_each_layer_imports_only_the_layers_below(layer):
+    allowed = LAYERS[layer]
     bad = violations(
-        lambda m: m.startswith("arlequin.solvers"),
-        lambda d: d.startswith(
-            (
-                "arlequin.io",
-                "arlequin.problem.arlequin_problem",
-                "arlequin.coupling.gluing",
-                "arlequin.demos",
-            )
+        lambda m: m == layer or m.startswith(layer + "."),
+        lambda d: (
+            not (d == layer or d.startswith(layer + "."))
+            and not any(d == a or d.startswith(a + ".") for a in allowed)
         ),
     )
     assert not bad, bad
