@@ -14,7 +14,8 @@ MultiBodyProblem                several bodies (problems or models) in one syste
 refine_region                   nested patches from coarse cells (:mod:`arlequin.coupling.patches`)
 RampWeights, ConstantWeights,
 CallableWeights                 partition weights (:mod:`arlequin.coupling.weights`)
-solve_static, solve             static and dynamic solves (:mod:`arlequin.solvers`)
+solve_static, solve,
+solve_quasi_static              static, dynamic and quasi-static solves (:mod:`arlequin.solvers`)
 DofMap                          the dof layout of a coupled system (:mod:`arlequin.dofs`)
 ResultsFolder                   results on disk (:mod:`arlequin.io`)
 evaluate_field, locate_points   fields at points, bounded point locator
@@ -102,6 +103,7 @@ from .io import ResultsFolder
 from .problem.arlequin_problem import ArlequinProblem
 from .problem.bodies import MultiBodyProblem
 from .solvers import DynamicResult, solve
+from .solvers.quasi_static import NewtonError, QuasiStaticResult, solve_quasi_static
 from .solvers.static import SingularSystemError, StaticResult, solve_static
 
 __version__ = "0.1.0"
@@ -119,10 +121,12 @@ __all__ = [
     "MediatorError",
     "MeshError",
     "MultiBodyProblem",
+    "NewtonError",
     "Overlap",
     "OverlapError",
     "Patch",
     "PatchCoupling",
+    "QuasiStaticResult",
     "RampWeights",
     "ResultsFolder",
     "SimulationError",
@@ -136,6 +140,7 @@ __all__ = [
     "locate_points",
     "refine_region",
     "solve",
+    "solve_quasi_static",
     "solve_static",
 ]
 

@@ -1,4 +1,4 @@
-"""Time integrators of coupled systems and the static solver.
+"""Solvers of coupled systems: time integrators, the static and the quasi-static solvers.
 
 Dynamic integrators (see ``docs/dynamics.md``), selected by name or class through
 :func:`get_integrator` / :func:`solve`:
@@ -22,7 +22,8 @@ One concept a module: ``operators`` (mass, forces, tangents), ``rows`` (constrai
 ``linalg`` (factorisations), ``impulses`` (the explicit impulse solve), ``damping`` (Rayleigh
 damping), ``controllers`` (step sizes), ``base`` (the :class:`Integrator` class), ``registry``,
 ``explicit``, ``subcycling``, ``implicit``, ``stability``, ``recorder``, ``result``, ``driver``
-(:func:`solve`), ``static``, ``loads``.
+(:func:`solve`), ``static``, ``quasi_static`` (load stepping with Newton,
+:func:`solve_quasi_static`), ``condensation`` (its Newton systems), ``loads``.
 """
 
 from ..contract import ConstraintError, SimulationError, UnilateralConstraint
@@ -35,6 +36,7 @@ from .explicit import CentralDifference
 from .implicit import HHTAlpha, ImplicitIntegrator, Newmark, ThetaScheme
 from .loads import Constant, LoadCurve, Ramp, Sine, SmoothStep, Tabulated
 from .operators import SystemOperators
+from .quasi_static import NewtonError, QuasiStaticResult, QuasiStaticSolver, solve_quasi_static
 from .recorder import Recorder
 from .registry import REGISTRY, get_integrator, register
 from .result import DynamicResult
@@ -58,6 +60,9 @@ __all__ = [
     "LinearInequality",
     "LoadCurve",
     "Newmark",
+    "NewtonError",
+    "QuasiStaticResult",
+    "QuasiStaticSolver",
     "Ramp",
     "RayleighDamping",
     "Recorder",
@@ -79,6 +84,7 @@ __all__ = [
     "is_unilateral",
     "register",
     "solve",
+    "solve_quasi_static",
     "solve_static",
     "stable_time_step",
 ]
