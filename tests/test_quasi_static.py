@@ -4,6 +4,8 @@ a nonlinear model with an exact tangent (quadratic convergence), and for its inp
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -18,8 +20,8 @@ from arlequin import (
     solve_static,
 )
 from arlequin.contract import StateError
-from arlequin.solvers import QuasiStaticSolver
 from arlequin.models import IsotropicElastic, LinearElastic
+from arlequin.solvers import QuasiStaticSolver
 
 STEEL = IsotropicElastic(young=210e9, poisson=0.3, density=7850.0)
 
@@ -89,7 +91,7 @@ def test_condensed_and_full_newton_agree_on_a_nonlinear_patch():
         assert QuasiStaticSolver(problem, condense=condense).saddle.condensed == condense
         runs.append(res)
         for hist in res.residuals:
-            for r0, r1 in zip(hist, hist[1:]):
+            for r0, r1 in itertools.pairwise(hist):
                 if r0 < 1e-3 and r1 > 1e-14:
                     assert r1 <= 10.0 * r0**2, hist
     a, b = runs
