@@ -227,6 +227,7 @@ class QuasiStaticSolver:
         self.mu = np.zeros(self.saddle.n_multipliers)
         self.dt = self.nominal
         self.history: list[QuasiStaticStep] = []
+        self._previous: tuple[np.ndarray, np.ndarray, float] | None = None
         self._first_stiffness: float | None = None
         self._last_stiffness: float | None = None
         self.status = "running"
@@ -267,9 +268,8 @@ class QuasiStaticSolver:
         """Newton at load factor ``lam`` from the committed state; returns the converged
         (u, μ, trial states, residual history) or raises :class:`_StepFailed`."""
         fixed_values, _ = self.prescribed(lam)
-        u = self.u.copy()
+        u, mu = self._predictor(lam)
         u[self.saddle.fixed] = fixed_values
-        mu = self.mu.copy()
         history: list[float] = []
         try:
             f_int, trial, kt = self.ops.internal_force(u, self.states, tangent=True)
@@ -296,6 +296,17 @@ class QuasiStaticSolver:
             f"{rel:.3e} > {self.tol:.1e})",
             "newton",
         )
+
+    def _predictor(self, lam: float) -> tuple[np.ndarray, np.ndarray]:
+        """The start of Newton: the last step's increment extrapolated to ``lam`` (the load
+        path is smooth; from the committed state with no increment, the first iteration would
+        see the elastic tangent of every point that was yielding), the committed state at the
+        first step."""
+        if self._previous is None:
+            return self.u.copy(), self.mu.copy()
+        u_prev, mu_prev, t_prev = self._previous
+        ratio = (lam - self.t) / (self.t - t_prev)
+        return self.u + ratio * (self.u - u_prev), self.mu + ratio * (self.mu - mu_prev)
 
     def _evaluate(self, u, lam, tangent: bool):
         """(f_int, trial states, tangent or None), or None where a model refuses u."""
@@ -373,6 +384,7 @@ class QuasiStaticSolver:
             if self._first_stiffness is None:
                 self._first_stiffness = stiffness
             self._last_stiffness = stiffness
+        self._previous = (self.u, self.mu, self.t)
         self.u, self.mu, self.states, self.t = u, mu, trial, lam
 
     def _stop(self, fail: _StepFailed, dt: float):
