@@ -8,6 +8,7 @@ they import besides its pure helpers (dof layout, reference elements, facet geom
 Modules: ``elastic`` (small-strain linear elasticity), ``hardening`` (isotropic hardening
 laws), ``j2`` (the J2 material point), ``kinematics`` (finite-strain Q1 kinematics, F-bar),
 ``j2_kernel`` (the compiled planar kernel), ``elastoplastic`` (finite-strain J2 model),
+``small_strain_j2`` (small-strain J2 with its consistent tangent),
 ``obstacles`` (rigid level-set obstacles), ``contact_geometry`` (contact surfaces and pairs),
 ``contact`` (the level-set Signorini–Moreau contact model and the Signorini baseline),
 ``friction`` (Coulomb friction in the level-set model).
@@ -58,11 +59,22 @@ from .plasticity.j2 import (
     j2_update,
 )
 from .plasticity.kinematics import Q1Kinematics
+from .plasticity.small_strain_j2 import (
+    SMALL_STRAIN_KINDS,
+    ReturnResult,
+    SmallStrainJ2,
+    SmallStrainState,
+    consistent_tangent,
+    from_mandel,
+    small_strain_return,
+    to_mandel,
+)
 
 __all__ = [
     "BACKENDS",
     "HARDENING_LAWS",
     "KINDS",
+    "SMALL_STRAIN_KINDS",
     "BulkViscosity",
     "CallableHardening",
     "ContactConvergenceError",
@@ -89,16 +101,23 @@ __all__ = [
     "PlaneObstacle",
     "PlasticState",
     "Q1Kinematics",
+    "ReturnResult",
     "RigidContactPair",
     "SignoriniContact",
+    "SmallStrainJ2",
+    "SmallStrainState",
     "SphereObstacle",
     "VoceHardening",
     "acoustic_impedance",
+    "consistent_tangent",
     "element_critical_step",
+    "from_mandel",
     "hencky_j2_return",
     "hencky_strain",
     "j2_return_map",
     "j2_update",
     "make_hardening",
     "scalar_element_for",
+    "small_strain_return",
+    "to_mandel",
 ]

@@ -39,12 +39,16 @@ from arlequin.models import (
     PlaneObstacle,
     RigidContactPair,
     SignoriniContact,
+    SmallStrainJ2,
+    VoceHardening,
 )
 from arlequin.problem.system import Block, BlockTerm, CoupledSystem
 from arlequin.solvers import LinearInequality, solve, stable_time_step
 
 STEEL = IsotropicElastic(210e9, 0.3, 7850.0)
 COPPER = J2Material(117e9, 0.35, 8930.0, 0.4e9, 0.1e9)
+SOFT = J2Material(117e9, 0.35, 8930.0, 20e6, 0.1e9)  # yields at a strain of 1.7e-4
+VOCE = VoceHardening(20e6, saturation=30e6, rate=50.0, modulus=1e8)
 
 
 def _shift(mesh, dx):
@@ -66,6 +70,13 @@ def _models():
         "j2-axi": (FiniteStrainJ2(quad, COPPER, "axisymmetric"), np.pi * (1.5**2 - 0.5**2) * 2),
         "j2-plane": (FiniteStrainJ2(quad, COPPER, "plane_strain"), 2.0),
         "j2-hex": (FiniteStrainJ2(hexa, COPPER, "3d"), 1.0),
+        # small-strain J2 soft enough that the contract's random u ~ 1e-4 m makes points flow
+        "ssj2-axi": (
+            SmallStrainJ2(quad, SOFT, "axisymmetric", kinematic_modulus=1e9, bbar=True),
+            np.pi * (1.5**2 - 0.5**2) * 2,
+        ),
+        "ssj2-plane": (SmallStrainJ2(tri, SOFT, "plane_strain", hardening=VOCE), 2.0),
+        "ssj2-hex": (SmallStrainJ2(hexa, SOFT, "3d", hardening=VOCE, kinematic_modulus=1e9), 1.0),
     }
 
 
