@@ -7,10 +7,12 @@ from __future__ import annotations
 
 import argparse
 
+from ..demos.pressure_vessel.config import PressureVesselConfig
 from .ball import add_ball_impact
 from .common import add_out as _add_out
 from .common import run_demo
 from .common import write_json as _write_json
+from .generate import add_demo
 from .sliding import add_sliding_block
 from .taylor import add_taylor_bar
 
@@ -25,6 +27,7 @@ def add_demos(sub) -> None:
     add_taylor_bar(sub)
     add_sliding_block(sub)
     add_ball_impact(sub)
+    add_demo(sub, PressureVesselConfig)
 
 
 def check_case(demo: str, args: argparse.Namespace) -> None:

@@ -12,7 +12,7 @@ from .folder import RESULTS_JSON, JsonResult, ResultsFolder, environment, jsonab
 from .history import HistoryCSV, read_history
 from .layout import BlockFields, FieldLayout
 from .meshes import UnsupportedMeshError, read_mesh
-from .run import DynamicRunWriter, write_static
+from .run import DynamicRunWriter, QuasiStaticRunWriter, write_static
 
 __all__ = [
     "RESULTS_JSON",
@@ -22,6 +22,7 @@ __all__ = [
     "FieldSeries",
     "HistoryCSV",
     "JsonResult",
+    "QuasiStaticRunWriter",
     "ResultsFolder",
     "UnsupportedMeshError",
     "environment",

@@ -1,4 +1,5 @@
-"""Writers of runs into a results folder: dynamic runs as they go, static solutions at once.
+"""Writers of runs into a results folder: dynamic and quasi-static runs as they go, static
+solutions at once.
 
 :class:`DynamicRunWriter` is a listener for :func:`arlequin.solvers.solve` (``on_record``):
 at every record it appends a history row (time, step, energies and works per block, the energy
@@ -15,7 +16,7 @@ import numpy as np
 from .folder import ResultsFolder
 from .layout import FieldLayout
 
-__all__ = ["DynamicRunWriter", "write_static"]
+__all__ = ["DynamicRunWriter", "QuasiStaticRunWriter", "write_static"]
 
 _ENERGIES = ("kinetic", "strain", "external_work", "coupling_work", "constraint_work",
              "kinetic_full_step", "damping_work")  # fmt: skip
@@ -96,6 +97,69 @@ class DynamicRunWriter:
         for name, (point, cell) in self.layout.frame(self.system.dofmap, u, v, multipliers).items():
             self.series[name].write(t, point, cell)
         self.frames_written.append(float(t))
+
+
+class QuasiStaticRunWriter:
+    """Writes a quasi-static run into a results folder as it goes: a listener of
+    :func:`arlequin.solvers.solve_quasi_static` (``on_step``), called after every converged
+    load step.
+
+    Each step appends a row to ``newton.csv`` (the load factor, its step, Newton iterations,
+    the first and last relative residuals, step cuts) and a frame to every block's field series
+    (displacement, the mediators' multipliers, the blocks' cell data such as ``alpha``, and the
+    cell data ``cell_data(solver)`` returns, e.g. ε̄p and the von Mises stress), at the "time"
+    λ. Frames and rows are flushed as they are written: an interrupted run keeps every
+    converged step.
+
+    Parameters
+    ----------
+    folder : ResultsFolder
+    system : CoupledSystem
+    layout : FieldLayout
+    cell_data : callable, optional
+        ``cell_data(solver) -> {block name: {field name: (n_cells,) array}}``.
+    units : mapping, optional
+        Units of those fields (recorded in results.json).
+    """
+
+    columns = ("load_factor", "step", "newton_iterations", "first_residual", "last_residual",
+               "cuts")  # fmt: skip
+
+    def __init__(self, folder: ResultsFolder, system: Any, layout: FieldLayout,
+                 cell_data: Any = None, units: dict[str, str] | None = None) -> None:  # fmt: skip
+        self.system, self.layout, self.cell_data = system, layout, cell_data
+        self.history = folder.history(
+            self.columns,
+            {
+                "load_factor": "1",
+                "step": "1",
+                "newton_iterations": "1",
+                "first_residual": "1",
+                "last_residual": "1",
+                "cuts": "1",
+            },
+            name="newton",
+        )
+        self.series = {bf.name: folder.series(bf.name, bf.mesh) for bf in layout.blocks}
+        folder.meta.setdefault("field_units", {}).update({**layout.units, **(units or {})})
+
+    def __call__(self, solver: Any) -> None:
+        rec = solver.history[-1]
+        self.history.append(
+            {
+                "load_factor": rec.load_factor,
+                "step": rec.step,
+                "newton_iterations": rec.iterations,
+                "first_residual": rec.residuals[0],
+                "last_residual": rec.residuals[-1],
+                "cuts": rec.cuts,
+            }
+        )
+        extra = self.cell_data(solver) if self.cell_data is not None else {}
+        multipliers = solver.saddle.split_multipliers(solver.mu)
+        frames = self.layout.frame(self.system.dofmap, solver.u, None, multipliers)
+        for name, (point, cell) in frames.items():
+            self.series[name].write(rec.load_factor, point, {**cell, **extra.get(name, {})})
 
 
 def write_static(folder: ResultsFolder, system: Any, result: Any, layout: FieldLayout) -> None:

@@ -1,0 +1,40 @@
+"""The pressure vessels: a thick sphere or cylinder under internal pressure, J2 plasticity,
+quasi-static (``arlequin pressure-vessel``).
+
+A sphere (axisymmetric: the meridional quarter) or a cylinder (plane strain: a quarter of the
+section), inner radius a and outer radius b, is pressurised at the bore (or its bore is moved
+radially) in equal load steps, each solved by Newton with the consistent tangents
+(:func:`arlequin.solve_quasi_static`). Model ``arlequin``: a coarse linear-elastic model of the
+whole wall and a refined J2 patch (small-strain :class:`~arlequin.models.SmallStrainJ2` or
+finite-strain :class:`~arlequin.models.FiniteStrainJ2`) from the bore to a chosen radius,
+glued by a coarse mediator in its outermost coarse ring; model ``mono``: one fine J2 mesh.
+
+Exact references (:mod:`arlequin.demos.pressure_vessel.hill`): for the sphere Hill's solution
+(first yield, the plastic front c, the outer displacement u_b, the limit load), for the
+cylinder first yield and the limit load.
+
+Outputs (``out``): results.json (inputs and results with units), history.csv is replaced by
+``newton.csv`` (per step: load factor, Newton iterations, residuals, cuts), the field series
+``fields/coarse.xdmf`` and ``fields/patch0.xdmf`` (displacement, α, the mediator's multipliers,
+ε̄p and the von Mises stress per cell, one frame a step), ``pressure_displacement.png`` and
+``plastic_zone.png``.
+"""
+
+from .config import PressureVesselConfig
+from .hill import sphere_outer_displacement, sphere_plastic_radius
+from .result import JSON_KEYS, PressureVesselResult
+
+__all__ = [
+    "JSON_KEYS",
+    "PressureVesselConfig",
+    "PressureVesselResult",
+    "run_pressure_vessel",
+    "sphere_outer_displacement",
+    "sphere_plastic_radius",
+]
+
+
+def run_pressure_vessel(out=None, progress=None, **options) -> PressureVesselResult:
+    """Run the pressure vessel with the options of :class:`PressureVesselConfig` (SI units);
+    ``out`` a results folder, ``progress(fraction)`` of the load."""
+    return PressureVesselConfig(**options).run(out=out, progress=progress)

@@ -1,0 +1,152 @@
+"""The configuration of the pressure-vessel demo: the single source of its options."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+from ..config import DemoConfig, check_choice, check_positive, check_range, option
+
+__all__ = ["MATERIALS", "MODELS", "SHAPES", "PressureVesselConfig"]
+
+SHAPES = ("sphere", "cylinder")
+MODELS = ("arlequin", "mono")
+MATERIALS = ("small-strain", "finite-strain")
+
+#: Default sizes, as fractions of the wall thickness b − a: 8 coarse cells and 64 fine cells
+#: across the wall (3 levels of refinement); the patch from the bore to 85% of the wall.
+COARSE_CELLS, FINE_CELLS, PATCH_FRACTION = 8, 64, 0.85
+
+
+@dataclass(frozen=True)
+class PressureVesselConfig(DemoConfig):
+    """A thick sphere (axisymmetric) or cylinder (plane strain, a quarter) under internal
+    pressure, J2 plasticity (see :mod:`arlequin.demos.pressure_vessel`)."""
+
+    command: ClassVar[str] = "pressure-vessel"
+    title: ClassVar[str] = (
+        "thick sphere or cylinder under internal pressure, J2 plasticity, against Hill's "
+        "solutions (quasi-static, Newton)"
+    )
+    description: ClassVar[str] = (
+        "A thick sphere (axisymmetric) or cylinder (plane strain, a quarter) of inner radius "
+        "A and outer radius B, pressurised at the bore (--pressure) or driven by the bore's "
+        "radial displacement (--inner-displacement), loaded in --steps equal steps solved by "
+        "Newton with consistent tangents. --model arlequin: a coarse linear-elastic model of "
+        "the whole wall and a refined J2 patch from the bore to --patch-outer; --model mono: "
+        "one fine J2 mesh. Against Hill's exact solutions (sphere) and the limit loads. SI "
+        "units."
+    )
+
+    shape: str = option("sphere", "the vessel", "", choices=SHAPES)
+    model: str = option("arlequin", "coarse elastic + J2 patch, or one fine mesh", "",
+                        choices=MODELS)  # fmt: skip
+    inner: float = option(0.1, "inner radius a", "m", metavar="A")
+    outer: float = option(0.2, "outer radius b", "m", metavar="B")
+    young: float = option(210e9, "Young's modulus E", "Pa", metavar="E")
+    poisson: float = option(0.3, "Poisson's ratio", "1", metavar="NU")
+    yield_stress: float = option(240e6, "yield stress", "Pa", flag="--yield", metavar="SY")
+    hardening: float = option(0.0, "linear isotropic hardening modulus (0: perfectly plastic)",
+                              "Pa", metavar="H")  # fmt: skip
+    material: str = option("small-strain", "J2 at small strain or at finite strain", "",
+                           choices=MATERIALS)  # fmt: skip
+    pressure: float | None = option(
+        None, "final internal pressure", "Pa", metavar="P", exclusive="load",
+        default_help="3e8 Pa unless --inner-displacement",
+    )  # fmt: skip
+    inner_displacement: float | None = option(
+        None, "final radial displacement of the bore, instead of a pressure", "m", metavar="U",
+        exclusive="load",
+    )  # fmt: skip
+    steps: int = option(10, "equal load steps (cut and grown back where Newton needs)", "1",
+                        metavar="N")  # fmt: skip
+    patch_outer: float | None = option(
+        None, "outer radius of the patch (rounded to a coarse ring)", "m", metavar="RP",
+        default_help="a + 0.85 (b - a)",
+    )  # fmt: skip
+    fine_size: float | None = option(None, "radial size of the fine cells", "m", metavar="H",
+                                     default_help="(b - a)/64")  # fmt: skip
+    coarse_size: float | None = option(None, "radial size of the coarse cells", "m",
+                                       metavar="H", default_help="(b - a)/8")  # fmt: skip
+
+    # -- resolved values ---------------------------------------------------------------------
+    @property
+    def load_pressure(self) -> float | None:
+        """The final pressure (Pa), None under a prescribed bore displacement."""
+        if self.inner_displacement is not None:
+            return None
+        return 3e8 if self.pressure is None else self.pressure
+
+    @property
+    def thickness(self) -> float:
+        return self.outer - self.inner
+
+    @property
+    def coarse(self) -> float:
+        """The coarse cells' radial size (m)."""
+        return self.coarse_size if self.coarse_size is not None else self.thickness / COARSE_CELLS
+
+    @property
+    def fine(self) -> float:
+        """The fine cells' radial size (m)."""
+        return self.fine_size if self.fine_size is not None else self.thickness / FINE_CELLS
+
+    @property
+    def patch_radius(self) -> float:
+        """The requested outer radius of the patch (m)."""
+        if self.patch_outer is not None:
+            return self.patch_outer
+        return self.inner + PATCH_FRACTION * self.thickness
+
+    # -- checks ------------------------------------------------------------------------------
+    def check(self) -> None:
+        check_choice("shape", self.shape, SHAPES)
+        check_choice("model", self.model, MODELS)
+        check_choice("material", self.material, MATERIALS)
+        check_positive("inner", self.inner, "m")
+        check_positive("outer", self.outer, "m")
+        if not self.inner < self.outer:
+            raise ValueError(
+                f"the inner radius must be below the outer one, got inner={self.inner} m >= "
+                f"outer={self.outer} m"
+            )
+        check_positive("young", self.young, "Pa")
+        check_range("poisson", self.poisson, -1.0, 0.5, closed="()")
+        check_positive("yield_stress", self.yield_stress, "Pa")
+        check_positive("hardening", self.hardening, "Pa", allow_zero=True)
+        if self.pressure is not None and self.inner_displacement is not None:
+            raise ValueError("give one of pressure and inner_displacement, got both")
+        check_positive("pressure", self.load_pressure, "Pa", allow_none=True)
+        check_positive("inner_displacement", self.inner_displacement, "m", allow_none=True)
+        if isinstance(self.steps, bool) or int(self.steps) != self.steps or self.steps < 1:
+            raise ValueError(f"steps must be an integer >= 1, got steps={self.steps!r}")
+        check_positive("coarse_size", self.coarse_size, "m", allow_none=True)
+        check_positive("fine_size", self.fine_size, "m", allow_none=True)
+        if self.fine > self.coarse:
+            raise ValueError(f"fine_size={self.fine} m must not exceed coarse_size={self.coarse} m")
+        if self.coarse > self.thickness:
+            raise ValueError(f"coarse_size={self.coarse} m exceeds the wall b - a = "
+                             f"{self.thickness} m")  # fmt: skip
+        if self.model == "arlequin" and not (
+            self.inner < self.patch_radius < self.outer - 0.5 * self.coarse
+        ):
+            raise ValueError(
+                f"patch_outer={self.patch_radius} m must lie inside the wall, between the bore "
+                f"a={self.inner} m and b - coarse_size/2 = {self.outer - 0.5 * self.coarse} m "
+                "(a coarse ring must stay outside the patch)"
+            )
+        if not math.isclose(math.log2(self.coarse / self.fine) % 1.0, 0.0, abs_tol=1e-6) and not (
+            math.isclose(math.log2(self.coarse / self.fine) % 1.0, 1.0, abs_tol=1e-6)
+        ):
+            raise ValueError(
+                f"coarse_size/fine_size = {self.coarse / self.fine:.6g} must be a power of 2 "
+                "(the patch is a nested refinement of the coarse cells)"
+            )
+
+    # -- running -----------------------------------------------------------------------------
+    def run(self, out: str | None = None, progress: Callable[[float], None] | None = None) -> Any:
+        from .run import run
+
+        return run(self, out=out, progress=progress)

@@ -1,0 +1,103 @@
+"""What a pressure-vessel run writes besides its history: the cell fields of each frame and
+its pictures (the pressure against the outer displacement with Hill's curve; the plastic zone
+at the end)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from ...io import ResultsFolder
+from . import hill
+from .result import PressureVesselResult
+from .setup import VesselSetup
+
+__all__ = ["cell_fields", "plot_plastic_zone", "plot_pressure_curve", "write_pictures"]
+
+
+def cell_fields(setup: VesselSetup) -> Callable[[Any], dict[str, dict[str, np.ndarray]]]:
+    """The cell data of a frame: the J2 model's ε̄p and von Mises stress, cell means."""
+    from .run import von_mises
+
+    def fields(solver: Any) -> dict[str, dict[str, np.ndarray]]:
+        state = solver.states[setup.plastic_block][0]
+        return {
+            setup.plastic_block: {
+                "eqps": np.asarray(state.eqps).mean(axis=1),
+                "von_mises": von_mises(state).mean(axis=1),
+            }
+        }
+
+    return fields
+
+
+def plot_pressure_curve(result: PressureVesselResult, config: dict, path: str) -> None:
+    """The bore pressure against the outer displacement, and Hill's (sphere) or the limit
+    load (cylinder)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    h = result.history
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.plot(np.array(h["outer_displacement"]) * 1e6, np.array(h["pressure"]) / 1e6, "o-",
+            label=f"{config['model']} ({config['material']})")  # fmt: skip
+    a, b, sy = config["inner"], config["outer"], config["yield_stress"]
+    if config["shape"] == "sphere":
+        p = np.linspace(0.0, 0.999 * hill.sphere_limit_load(a, b, sy), 200)
+        u = [hill.sphere_outer_displacement(x, a, b, config["young"], config["poisson"], sy)
+             for x in p]  # fmt: skip
+        ax.plot(np.array(u) * 1e6, p / 1e6, "k--", label="Hill (exact)")
+    else:
+        ax.axhline(hill.cylinder_limit_load(a, b, sy) / 1e6, color="k", ls="--",
+                   label="limit load (2/√3) σy ln(b/a)")  # fmt: skip
+    ax.set_xlabel("outer radial displacement (µm)")
+    ax.set_ylabel("bore pressure (MPa)")
+    ax.set_title(f"thick {config['shape']}, a = {a * 1e3:g} mm, b = {b * 1e3:g} mm")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def plot_plastic_zone(setup: VesselSetup, state: Any, path: str) -> None:
+    """ε̄p over the J2 model's cells at the end of the run, the coarse mesh's edges beside."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.collections import PolyCollection
+
+    mesh = setup.plastic_model.mesh
+    polys = np.transpose(mesh.p[:, mesh.t], (2, 1, 0))
+    fig, ax = plt.subplots(figsize=(5, 5))
+    coll = PolyCollection(polys, array=np.asarray(state.eqps).mean(axis=1), cmap="viridis",
+                          edgecolors="none")  # fmt: skip
+    ax.add_collection(coll)
+    coarse = setup.meshes.coarse
+    ax.add_collection(
+        PolyCollection(
+            np.transpose(coarse.p[:, coarse.t], (2, 1, 0)),
+            facecolors="none",
+            edgecolors="0.6",
+            linewidths=0.4,
+        )
+    )
+    ax.autoscale()
+    ax.set_aspect("equal")
+    fig.colorbar(coll, ax=ax, label="equivalent plastic strain")
+    ax.set_title("plastic zone (patch or fine mesh) over the coarse mesh")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def write_pictures(folder: ResultsFolder, setup: VesselSetup, qs: Any,
+                   result: PressureVesselResult) -> None:  # fmt: skip
+    """The run's pictures in its results folder."""
+    plot_pressure_curve(result, result.config, str(folder.picture("pressure_displacement")))
+    state = qs.states[setup.plastic_block][0]
+    plot_plastic_zone(setup, state, str(folder.picture("plastic_zone")))

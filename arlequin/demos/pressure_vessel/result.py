@@ -1,0 +1,89 @@
+"""The result of a pressure-vessel run: its JSON keys (the Interface), units and summary."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from ...io import JsonResult
+
+__all__ = ["HISTORY_KEYS", "JSON_KEYS", "UNITS", "PressureVesselResult"]
+
+#: The Interface's keys, in order.
+JSON_KEYS = ("first_yield_pressure", "limit_load_reached", "limit_load", "n_elements", "n_dofs",
+             "patch_fraction", "wall_time_s", "history")  # fmt: skip
+#: The keys of ``history``: one value per converged step (the initial state first).
+HISTORY_KEYS = ("pressure", "plastic_radius", "outer_displacement", "inner_displacement",
+                "newton_iterations", "residuals")  # fmt: skip
+UNITS = {
+    "first_yield_pressure": "Pa",
+    "limit_load": "Pa",
+    "n_elements": "1",
+    "n_dofs": "1",
+    "patch_fraction": "1",
+    "wall_time_s": "s",
+    "pressure": "Pa",
+    "plastic_radius": "m",
+    "outer_displacement": "m",
+    "inner_displacement": "m",
+    "newton_iterations": "1",
+    "residuals": "1",
+    "reference": "",
+}
+
+
+@dataclass
+class PressureVesselResult(JsonResult):
+    """What a pressure-vessel run computed (SI units).
+
+    Attributes
+    ----------
+    first_yield_pressure : float
+        The bore pressure at which the first quadrature point of the J2 model yields (Pa),
+        from the elastic response (linear up to first yield).
+    limit_load_reached : bool
+        The load could not increase further (a mechanism).
+    limit_load : float or None
+        The last converged bore pressure then (Pa).
+    n_elements, n_dofs : int
+        Cells and dofs of the run (every model's).
+    patch_fraction : float
+        The patch's share of the wall's area (1 for ``mono``).
+    wall_time_s : float
+    history : dict
+        Per converged step (the initial state first): ``pressure`` (Pa; under a prescribed
+        bore displacement, the pressure that displacement needs, from the reactions),
+        ``plastic_radius`` (m: the largest radius of the region with ε̄p > 0, interpolated
+        between quadrature points; ``inner`` before first yield), ``outer_displacement`` and
+        ``inner_displacement`` (radial, m), ``newton_iterations`` and ``residuals`` (each
+        step's relative residuals; 0 and [] for the initial state).
+    reference : dict
+        Hill's values at the final pressure (sphere), first yield and the limit load.
+    """
+
+    first_yield_pressure: float
+    limit_load_reached: bool
+    limit_load: float | None
+    n_elements: int
+    n_dofs: int
+    patch_fraction: float
+    wall_time_s: float
+    history: dict[str, list[Any]]
+    reference: dict[str, float] = field(default_factory=dict)
+    config: dict[str, Any] = field(default_factory=dict)
+
+    json_exclude = ("config",)
+
+    def summary(self) -> str:
+        """One line: first yield, the final state, Newton."""
+        h = self.history
+        its = h["newton_iterations"][1:]
+        end = (f"limit load {self.limit_load / 1e6:.2f} MPa" if self.limit_load_reached
+               else f"P = {h['pressure'][-1] / 1e6:.2f} MPa")  # fmt: skip
+        return (
+            f"{self.config.get('shape', 'vessel')} ({self.config.get('model')}): first yield "
+            f"{self.first_yield_pressure / 1e6:.3f} MPa, {end}: plastic radius "
+            f"{h['plastic_radius'][-1] * 1e3:.3f} mm, outer displacement "
+            f"{h['outer_displacement'][-1] * 1e6:.3f} µm; {len(its)} steps, Newton "
+            f"{sum(its)} iterations (max {max(its, default=0)}), {self.wall_time_s:.1f} s"
+        )

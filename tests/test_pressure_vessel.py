@@ -1,0 +1,140 @@
+"""The pressure-vessel demo (arlequin.demos.pressure_vessel) against Hill's exact solutions.
+
+Reference values (issue 29; small strain, perfectly plastic, E = 210 GPa, ν = 0.3,
+σy = 240 MPa, a = 100 mm, b = 200 mm): sphere P0 = 140.0 MPa; at 200 MPa c = 115.99 mm,
+u_b = 31.212 µm; at 300 MPa c = 157.56 mm, u_b = 78.233 µm; limit 332.71 MPa. Cylinder (plane
+strain): P0 = 103.75 MPa, limit 192.09 MPa.
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+import math
+
+import numpy as np
+import pytest
+
+from arlequin.demos.pressure_vessel import PressureVesselConfig, hill, run_pressure_vessel
+from arlequin.demos.pressure_vessel.result import HISTORY_KEYS, JSON_KEYS
+
+A, B, E, NU, SY = 0.1, 0.2, 210e9, 0.3, 240e6
+
+
+def test_hill_reference_values():
+    """Hill's formulas give the issue's reference values (its digits)."""
+    assert hill.sphere_first_yield(A, B, SY) == pytest.approx(140.0e6, rel=1e-12)
+    assert hill.sphere_plastic_radius(200e6, A, B, SY) == pytest.approx(115.99e-3, abs=5e-6)
+    assert hill.sphere_outer_displacement(200e6, A, B, E, NU, SY) == pytest.approx(
+        31.212e-6, abs=5e-10
+    )
+    assert hill.sphere_plastic_radius(300e6, A, B, SY) == pytest.approx(157.56e-3, abs=5e-6)
+    assert hill.sphere_outer_displacement(300e6, A, B, E, NU, SY) == pytest.approx(
+        78.233e-6, abs=5e-10
+    )
+    assert hill.sphere_limit_load(A, B, SY) == pytest.approx(332.71e6, abs=5e3)
+    assert hill.cylinder_first_yield(A, B, NU, SY) == pytest.approx(103.75e6, abs=5e3)
+    assert hill.cylinder_limit_load(A, B, SY) == pytest.approx(192.09e6, abs=5e3)
+    # the elastic and the plastic outer displacements meet at first yield
+    p0 = hill.sphere_first_yield(A, B, SY)
+    below = hill.sphere_outer_displacement(p0 * (1 - 1e-12), A, B, E, NU, SY)
+    above = hill.sphere_outer_displacement(p0 * (1 + 1e-12), A, B, E, NU, SY)
+    assert below == pytest.approx(above, rel=1e-9)
+
+
+#: A coarse set-up for the default test run: 16 fine cells across the wall (4 coarse).
+COARSE = {"coarse_size": 0.025, "fine_size": 0.025 / 4}
+
+
+@pytest.mark.parametrize("model", ["arlequin", "mono"])
+def test_sphere_coarse_run_against_hill(model):
+    """16 fine cells across the wall, 300 MPa in 10 steps. Measured (this resolution): first
+    yield +0.5 to +0.7%, c at 300 MPa −0.4%, u_b −1.6%; the bounds below are twice those
+    (the issue's 0.5% / 1% bounds hold at the default resolution: the slow test)."""
+    r = run_pressure_vessel(model=model, **COARSE)
+    h = r.history
+    assert r.first_yield_pressure == pytest.approx(140.0e6, rel=0.015)
+    assert h["pressure"][-1] == pytest.approx(300e6, rel=1e-12)
+    assert h["plastic_radius"][-1] == pytest.approx(157.56e-3, rel=0.01)
+    assert h["outer_displacement"][-1] == pytest.approx(78.233e-6, rel=0.035)
+    assert not r.limit_load_reached
+    assert max(h["newton_iterations"]) <= 8
+    assert set(JSON_KEYS) <= set(r.to_json()) and set(HISTORY_KEYS) == set(h)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("material", ["small-strain"])
+def test_sphere_default_resolution_meets_the_issue_bounds(material):
+    """The default resolution (64 fine cells across the wall, the patch to 185 mm), 15 steps
+    of 20 MPa (200 and 300 MPa both reached): first yield within 0.5% of P0; c within 1% and
+    one fine cell, u_b within 1% of Hill at 200 and 300 MPa; Arlequin and mono within 0.5%;
+    Newton quadratic below 1e-3 (each residual ≤ 10 × the previous one squared, until 1e-10).
+    """
+    runs = {}
+    for model in ("arlequin", "mono"):
+        r = run_pressure_vessel(model=model, material=material, steps=15)
+        runs[model] = r
+        h = r.history
+        assert r.first_yield_pressure == pytest.approx(140.0e6, rel=0.005)
+        for p in (200e6, 300e6):
+            i = int(np.argmin(np.abs(np.array(h["pressure"]) - p)))
+            assert h["pressure"][i] == pytest.approx(p, rel=1e-12)
+            c = hill.sphere_plastic_radius(p, A, B, SY)
+            ub = hill.sphere_outer_displacement(p, A, B, E, NU, SY)
+            assert abs(h["plastic_radius"][i] - c) <= min(0.01 * c, (B - A) / 64)
+            assert h["outer_displacement"][i] == pytest.approx(ub, rel=0.01)
+        for res in h["residuals"][1:]:
+            for r0, r1 in itertools.pairwise(res):
+                if r0 < 1e-3 and r1 > 1e-10:
+                    assert r1 <= 10.0 * r0**2, res
+    a, m = runs["arlequin"].history, runs["mono"].history
+    for key in ("plastic_radius", "outer_displacement"):
+        assert a[key][-1] == pytest.approx(m[key][-1], rel=0.005)
+
+
+@pytest.mark.parametrize(
+    ("options", "match"),
+    [
+        ({"pressure": -1.0}, "pressure"),
+        ({"pressure": 0.0}, "pressure"),
+        ({"inner": 0.2, "outer": 0.1}, "inner radius"),
+        ({"patch_outer": 0.25}, "patch_outer"),
+        ({"patch_outer": 0.05}, "patch_outer"),
+        ({"yield_stress": 0.0}, "yield_stress"),
+        ({"hardening": -1e9}, "hardening"),
+        ({"steps": 0}, "steps"),
+        ({"shape": "torus"}, "shape"),
+        ({"pressure": 1e8, "inner_displacement": 1e-4}, "one of"),
+        ({"coarse_size": 0.02, "fine_size": 0.003}, "power of 2"),
+    ],
+)
+def test_bad_input_named_before_any_work(options, match):
+    with pytest.raises(ValueError, match=match):
+        PressureVesselConfig(**options)
+
+
+def test_cli_writes_the_interface_json_and_a_results_folder(tmp_path, capsys):
+    """The command's JSON has the Interface's keys; the folder its results.json (inputs as
+    plain JSON), the Newton history, one XDMF frame per step and the pictures."""
+    from arlequin.cli.main import main
+    from arlequin.io import read_history, read_series
+
+    out, js = tmp_path / "run", tmp_path / "pv.json"
+    argv = ["pressure-vessel", "--shape", "cylinder", "--pressure", "1.5e8", "--steps", "3",
+            "--coarse-size", "0.025", "--fine-size", "0.0125", "--out", str(out), "--json",
+            str(js), "--quiet"]  # fmt: skip
+    assert main(argv) == 0
+    data = json.loads(js.read_text())
+    assert list(data)[: len(JSON_KEYS)] == list(JSON_KEYS)
+    assert set(data["history"]) == set(HISTORY_KEYS)
+    assert len(data["history"]["pressure"]) == 4
+    meta = json.loads((out / "results.json").read_text())
+    assert meta["status"] == "complete"
+    assert meta["inputs"]["yield_stress"] == {"value": 240e6, "unit": "Pa"}
+    rows = read_history(out / "newton.csv")
+    assert len(rows["load_factor"]) == 3
+    _mesh, frames = read_series(out / "fields" / "patch0.xdmf")
+    assert len(frames) == 3 and "eqps" in frames[-1][2]
+    assert (out / "pressure_displacement.png").exists() and (out / "plastic_zone.png").exists()
+    assert "first yield" in capsys.readouterr().out
+    assert math.isfinite(data["first_yield_pressure"])
