@@ -126,3 +126,33 @@ def test_a_state_error_cuts_the_step_then_stops_with_a_named_error():
 def test_bad_input_is_named(kwargs, match):
     with pytest.raises(ValueError, match=match):
         solve_quasi_static(_problem(), **kwargs)
+
+
+def test_solve_static_never_gives_the_linear_answer_of_a_nonlinear_problem():
+    """A nonlinear patch: solve_static solves it by Newton (the quasi-static solution in one
+    load step, to the solver's tolerance), not by the linear solve of its initial stiffness."""
+    problem = _problem(lambda m: StiffeningElastic(m, STEEL, "plane_strain", c=2e-16))
+    static = solve_static(problem)
+    qs = solve_quasi_static(problem, load=1.0, steps=4)
+    assert np.linalg.norm(static.u - qs.u) <= 1e-8 * np.linalg.norm(qs.u)
+    assert static.residual <= 1e-10
+    assert set(static.strain_energy) == {"coarse"}  # the nonlinear block's is not given
+    linear = solve_static(_problem())
+    assert np.linalg.norm(static.u - linear.u) > 1e-3 * np.linalg.norm(linear.u)
+
+
+def test_solve_static_of_a_yielding_j2_patch_is_elastoplastic():
+    """SmallStrainJ2 (σy = 240 MPa, H = 10 GPa) pulled past yield (issue 29's report: the
+    linear answer came back without a word): a plane-strain bar free laterally yields at
+    σ_xx = σy / √(1 − ν + ν²) = 270 MPa; at 350 MPa the plastic strain of the patch's half
+    (≈ 6e-3) is several times the elastic strain (1.7e-3), so the tip moves more than 1.2 times
+    the elastic answer."""
+    from arlequin.models import J2Material, SmallStrainJ2
+
+    mat = J2Material(210e9, 0.3, 7850.0, 240e6, hardening_modulus=10e9)
+    problem = _problem(lambda m: SmallStrainJ2(m, mat, "plane_strain", bbar=True), 3.5e8)
+    plastic = solve_static(problem)
+    elastic = solve_static(_problem(traction=3.5e8))
+    # the tip is in the patch, which carries the energy there (measured ratio 2.32)
+    tip = np.max(plastic.displacements["patch0"][0::2])
+    assert tip > 1.2 * np.max(elastic.displacements["patch0"][0::2])

@@ -179,6 +179,9 @@ class QuasiStaticSolver:
     condense : bool
         Condense the linear blocks once (True) or factor the whole saddle point at every
         iteration (False, the reference).
+    reference_time : float
+        With ``proportional``, the time (s) at which the system's loads and prescribed values
+        are taken as those of λ = 1 (default 1).
     t0, u0, states :
         Start (default λ = 0, zero displacement, the models' initial states).
     """
@@ -197,6 +200,7 @@ class QuasiStaticSolver:
         line_search: bool = True,
         max_backtracks: int = 6,
         condense: bool = True,
+        reference_time: float = 1.0,
         t0: float = 0.0,
         u0: Any = None,
         states: dict[str, list[Any]] | None = None,
@@ -215,6 +219,7 @@ class QuasiStaticSolver:
         if not (self.min_step > 0.0 and self.min_step <= self.nominal):
             raise ValueError(f"min_step must lie in (0, {self.nominal}], got {min_step}")
         self.proportional, self.tol = bool(proportional), float(tol)
+        self.reference_time = float(reference_time)
         self.max_iterations, self.growth = int(max_iterations), float(growth)
         self.easy_iterations, self.line_search = int(easy_iterations), bool(line_search)
         self.max_backtracks = int(max_backtracks)
@@ -236,12 +241,12 @@ class QuasiStaticSolver:
     def external_force(self, lam: float) -> np.ndarray:
         """f_ext(λ) (N), shape (n,)."""
         if self.proportional:
-            return lam * self.system.external_force(1.0)
+            return lam * self.system.external_force(self.reference_time)
         return self.system.external_force(lam)
 
     def prescribed(self, lam: float) -> tuple[np.ndarray, np.ndarray]:
         """The Dirichlet values and the other rows' right-hand sides at λ."""
-        t = 1.0 if self.proportional else lam
+        t = self.reference_time if self.proportional else lam
         scale = lam if self.proportional else 1.0
         fixed, g = self.saddle.rhs_at(t)
         return scale * fixed, scale * g
@@ -476,7 +481,8 @@ def solve_quasi_static(
         Called likewise; returning True stops the run (status ``"stopped"``).
     **options
         Passed to :class:`QuasiStaticSolver` (``proportional``, ``tol``, ``max_iterations``,
-        ``min_step``, ``growth``, ``line_search``, ``condense``, ``t0``, ``u0``, ``states``).
+        ``min_step``, ``growth``, ``line_search``, ``condense``, ``reference_time``, ``t0``,
+        ``u0``, ``states``).
 
     Returns
     -------

@@ -12,13 +12,17 @@ constraint rows' dual (N for Dirichlet reactions).
 
 from __future__ import annotations
 
+import logging
 from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from ..contract import is_linear
 from ..problem.system import CoupledSystem
+
+logger = logging.getLogger(__name__)
 
 __all__ = [
     "SaddlePoint",
@@ -183,7 +187,7 @@ class StaticResult:
     residual: float
     u: np.ndarray
     system: CoupledSystem = field(repr=False)
-    saddle_point: SaddlePoint = field(repr=False)
+    saddle_point: SaddlePoint | None = field(repr=False)
 
 
 def rigid_modes(system: CoupledSystem) -> tuple[np.ndarray, list[str]] | None:
@@ -282,6 +286,14 @@ def _solve_saddle(mat: sp.csc_matrix, rhs: np.ndarray) -> np.ndarray:
 def solve_static(problem, t: float = 0.0) -> StaticResult:
     """Solve the static coupled problem (an ``ArlequinProblem`` or a ``CoupledSystem``).
 
+    A problem whose models are all linear is one sparse solve of the saddle point. A problem
+    with a nonlinear model (an elastoplastic patch) is never given its linear answer: it is
+    solved by Newton with the consistent tangents, as one load step of
+    :func:`~arlequin.solvers.quasi_static.solve_quasi_static` (cut automatically where Newton
+    needs it) from the unloaded state to the loads at ``t``; a path-dependent material then
+    follows a proportional path (call ``solve_quasi_static`` for another path, for the history
+    of the steps, or to resume). The strain energies of its nonlinear blocks are not given.
+
     Raises
     ------
     SingularSystemError
@@ -292,6 +304,8 @@ def solve_static(problem, t: float = 0.0) -> StaticResult:
     """
     system = problem if isinstance(problem, CoupledSystem) else problem.system()
     check_supports(system, t)
+    if not all(is_linear(term.model) for b in system.blocks for term in b.terms):
+        return _solve_nonlinear(system, t)
     sp_sys = assemble_saddle_point(system, t)
     bad = np.nonzero(~np.isfinite(sp_sys.load))[0]
     if bad.size:
@@ -319,4 +333,31 @@ def solve_static(problem, t: float = 0.0) -> StaticResult:
         u=u,
         system=system,
         saddle_point=sp_sys,
+    )
+
+
+def _solve_nonlinear(system: CoupledSystem, t: float) -> StaticResult:
+    """A nonlinear static problem as one load step of the quasi-static solver."""
+    from .quasi_static import solve_quasi_static
+
+    logger.info("solve_static: nonlinear models, solved by Newton (one quasi-static load step)")
+    qs = solve_quasi_static(system, load=1.0, steps=1, reference_time=t)
+    if qs.status != "completed":
+        raise SingularSystemError(
+            f"the nonlinear static problem has no solution at the given loads: {qs.message} "
+            "(use solve_quasi_static to follow the load up to there)"
+        )
+    energies = {
+        b.name: 0.5 * float(qs.u[b.dofs] @ (system.block_stiffness(b) @ qs.u[b.dofs]))
+        for b in system.blocks
+        if all(is_linear(term.model) for term in b.terms)
+    }
+    return StaticResult(
+        displacements=qs.displacements,
+        multipliers=qs.multipliers,
+        strain_energy=energies,
+        residual=qs.steps[-1].residuals[-1],
+        u=qs.u,
+        system=system,
+        saddle_point=None,
     )
