@@ -31,7 +31,8 @@ class PressureVesselConfig(DemoConfig):
         "solutions (quasi-static, Newton)"
     )
     description: ClassVar[str] = (
-        "A thick sphere (axisymmetric) or cylinder (plane strain, a quarter) of inner radius "
+        "A thick sphere (axisymmetric, or its eighth in hexahedra with --dim 3) or cylinder "
+        "(plane strain, a quarter) of inner radius "
         "A and outer radius B, pressurised at the bore (--pressure) or driven by the bore's "
         "radial displacement (--inner-displacement), loaded in --steps equal steps solved by "
         "Newton with consistent tangents. --model arlequin: a coarse linear-elastic model of "
@@ -41,6 +42,10 @@ class PressureVesselConfig(DemoConfig):
     )
 
     shape: str = option("sphere", "the vessel", "", choices=SHAPES)
+    dim: int = option(
+        2, "2: the axisymmetric sphere or plane-strain cylinder; 3: the sphere's eighth in "
+        "hexahedra", "1", choices=(2, 3),
+    )  # fmt: skip
     model: str = option("arlequin", "coarse elastic + J2 patch, or one fine mesh", "",
                         choices=MODELS)  # fmt: skip
     inner: float = option(0.1, "inner radius a", "m", metavar="A")
@@ -105,6 +110,9 @@ class PressureVesselConfig(DemoConfig):
         check_choice("shape", self.shape, SHAPES)
         check_choice("model", self.model, MODELS)
         check_choice("material", self.material, MATERIALS)
+        check_choice("dim", self.dim, (2, 3))
+        if self.dim == 3 and self.shape != "sphere":
+            raise ValueError(f"dim=3 models the sphere's eighth only, got shape={self.shape!r}")
         check_positive("inner", self.inner, "m")
         check_positive("outer", self.outer, "m")
         if not self.inner < self.outer:

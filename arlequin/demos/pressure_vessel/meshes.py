@@ -1,4 +1,5 @@
-"""Meshes of the pressure vessels: the quarter annulus a ≤ ρ ≤ b, 0 ≤ θ ≤ π/2, in quadrilaterals.
+"""Meshes of the pressure vessels: the quarter annulus a ≤ ρ ≤ b, 0 ≤ θ ≤ π/2, in quadrilaterals
+(the sphere's octant in hexahedra: :mod:`~arlequin.demos.pressure_vessel.meshes_3d`).
 
 The same section serves both vessels: the meridional quarter of the sphere (x = r, the radius
 from the axis, y = z along the axis; axisymmetric) and the quarter of the cylinder's cross
@@ -20,8 +21,15 @@ import numpy as np
 import skfem
 
 from ...coupling.patches import refine_region
+from .meshes_3d import octant_sphere_mesh
 
-__all__ = ["VesselMeshes", "annulus_mesh", "refine_projected", "vessel_meshes"]
+__all__ = [
+    "VesselMeshes",
+    "annulus_mesh",
+    "project_boundary_nodes",
+    "refine_projected",
+    "vessel_meshes",
+]
 
 
 def annulus_mesh(a: float, b: float, n_radial: int, n_angular: int) -> skfem.MeshQuad:
@@ -37,20 +45,18 @@ def annulus_mesh(a: float, b: float, n_radial: int, n_angular: int) -> skfem.Mes
     return skfem.MeshQuad(p, grid.t)
 
 
-def _project(mesh: skfem.Mesh, radius: float) -> skfem.Mesh:
-    """The mesh with the nodes of its boundary facets along the circle ``radius`` moved
-    radially onto it: the facets whose ends lie within 1% of the radius from it and that run
-    along it (their ends' radii differ by less than half their length; the radial facets of
-    the symmetry lines do not)."""
+def project_boundary_nodes(mesh: skfem.Mesh, radius: float) -> skfem.Mesh:
+    """The mesh with the nodes of its boundary facets on the sphere ``radius`` (every node of
+    the facet within 1% of it, the facet running along it) moved radially onto it."""
     bf = mesh.boundary_facets()
-    ends = mesh.p[:, mesh.facets[:, bf]]  # (dim, 2, n_bf)
-    rr = np.linalg.norm(ends, axis=0)  # (2, n_bf)
-    length = np.linalg.norm(ends[:, 0] - ends[:, 1], axis=0)
+    nodes = mesh.facets[:, bf]
+    rr = np.linalg.norm(mesh.p[:, nodes], axis=0)  # (n_facet_nodes, n_bf)
+    size = np.linalg.norm(mesh.p[:, nodes[0]] - mesh.p[:, nodes[1]], axis=0)
     near = np.all(np.abs(rr - radius) <= 0.01 * radius, axis=0)
-    along = np.abs(rr[0] - rr[1]) < 0.5 * length
-    nodes = np.unique(mesh.facets[:, bf[near & along]])
+    along = np.ptp(rr, axis=0) < 0.5 * size
+    on = np.unique(nodes[:, near & along])
     p = mesh.p.copy()
-    p[:, nodes] *= radius / np.linalg.norm(p[:, nodes], axis=0)
+    p[:, on] *= radius / np.linalg.norm(p[:, on], axis=0)
     return type(mesh)(p, mesh.t)
 
 
@@ -63,7 +69,7 @@ def refine_projected(mesh: skfem.Mesh, levels: int, circles: tuple[float, ...],
     for _ in range(levels):
         out = refine_region(out, levels=1, cells=np.arange(out.nelements))
         for radius in circles:
-            out = _project(out, radius)
+            out = project_boundary_nodes(out, radius)
     return out
 
 
@@ -73,11 +79,11 @@ class VesselMeshes:
 
     Attributes
     ----------
-    coarse : skfem.MeshQuad
+    coarse : skfem.MeshQuad or skfem.MeshHex
         The polar grid of the whole wall.
-    patch : skfem.MeshQuad or None
+    patch : skfem.Mesh or None
         The refined rings from the bore to ``patch_outer`` (model ``arlequin``).
-    mono : skfem.MeshQuad or None
+    mono : skfem.Mesh or None
         The whole wall at the patch's resolution (model ``mono``).
     patch_outer : float
         The patch's outer radius (m): the outer circle of the last ring it covers.
@@ -87,26 +93,32 @@ class VesselMeshes:
         Refinement levels of the patch (each halves the cells).
     """
 
-    coarse: skfem.MeshQuad
-    patch: skfem.MeshQuad | None
-    mono: skfem.MeshQuad | None
+    coarse: skfem.Mesh
+    patch: skfem.Mesh | None
+    mono: skfem.Mesh | None
     patch_outer: float
     ring_width: float
     levels: int
 
 
 def vessel_meshes(a: float, b: float, coarse_size: float, fine_size: float,
-                  patch_outer: float, model: str) -> VesselMeshes:  # fmt: skip
-    """The coarse grid (radial cells of about ``coarse_size``, angular ones of about the same
-    length at the mean radius), and the patch (rings whose mid-radius is below
-    ``patch_outer``) or the single mesh, ``log2(coarse_size / fine_size)`` levels finer."""
+                  patch_outer: float, model: str, dim: int = 2) -> VesselMeshes:  # fmt: skip
+    """The coarse grid (radial cells of about ``coarse_size``, the others of about the same
+    length at the mean radius: the quarter annulus in 2D, the sphere's octant in 3D), and the
+    patch (shells whose mid-radius is below ``patch_outer``) or the single mesh,
+    ``log2(coarse_size / fine_size)`` levels finer."""
     n_radial = max(1, round((b - a) / coarse_size))
-    n_angular = max(2, round(0.25 * math.pi * (a + b) / coarse_size))
-    coarse = annulus_mesh(a, b, n_radial, n_angular)
+    if dim == 2:
+        n_angular = max(2, round(0.25 * math.pi * (a + b) / coarse_size))
+        coarse = annulus_mesh(a, b, n_radial, n_angular)
+    else:
+        # 3 n² surface cells share the octant's area π ρ²/2 at the mean radius
+        n = max(1, round(0.5 * (a + b) * math.sqrt(math.pi / 6.0) / coarse_size))
+        coarse = octant_sphere_mesh(a, b, n, n_radial)
     levels = max(0, round(math.log2(coarse_size / fine_size)))
     ring = (b - a) / n_radial
     n_rings = min(n_radial, max(1, round((patch_outer - a) / ring)))
-    r_cells = np.linalg.norm(coarse.p[:, coarse.t].mean(axis=1), axis=0)
+    r_cells = np.linalg.norm(coarse.p[:, coarse.t].mean(axis=1), axis=0)  # cell centres
     patch = mono = None
     if model == "mono":
         mono = refine_projected(coarse, levels, (a, b))

@@ -2,7 +2,8 @@
 
 The quarter section (:mod:`arlequin.demos.pressure_vessel.meshes`) has two symmetry lines:
 x = 0 (the sphere's axis, the cylinder's vertical plane: u_x = 0) and y = 0 (the equator or the
-horizontal plane: u_y = 0), held on every model. The bore carries the pressure, a traction
+horizontal plane: u_y = 0), held on every model; the sphere's eighth in 3D has three symmetry
+planes x_i = 0 (u_i = 0). The bore carries the pressure, a traction
 −P n on its facets (n the outward normal of the faceted bore), or a prescribed radial
 displacement U e_r on its nodes (on every model that reaches it).
 """
@@ -90,14 +91,16 @@ def build(config: PressureVesselConfig) -> VesselSetup:
     """The problem of ``config`` (supports and the load at λ = 1: the final pressure, or the
     final bore displacement)."""
     a, b = config.inner, config.outer
-    kind = "axisymmetric" if config.shape == "sphere" else "plane_strain"
-    meshes = vessel_meshes(a, b, config.coarse, config.fine, config.patch_radius, config.model)
+    kind = {2: "axisymmetric" if config.shape == "sphere" else "plane_strain", 3: "3d"}[config.dim]
+    meshes = vessel_meshes(a, b, config.coarse, config.fine, config.patch_radius, config.model,
+                           config.dim)  # fmt: skip
+    origin = (0.0,) * (config.dim - 1)
     if config.model == "mono":
         plastic = _plastic_model(config, meshes.mono, kind)
         problem = ArlequinProblem(plastic, [])
         blocks, plastic_block = ["coarse"], "coarse"
-        outer = ("coarse", _node_at(meshes.mono, (b, 0.0)))
-        inner = ("coarse", _node_at(meshes.mono, (a, 0.0)))
+        outer = ("coarse", _node_at(meshes.mono, (b, *origin)))
+        inner = ("coarse", _node_at(meshes.mono, (a, *origin)))
     else:
         elastic = IsotropicElastic(config.young, config.poisson, DENSITY)
         coarse = LinearElastic(meshes.coarse, elastic, kind)
@@ -116,11 +119,13 @@ def build(config: PressureVesselConfig) -> VesselSetup:
         for w in caught:
             logger.info("%s", w.message)
         blocks, plastic_block = ["coarse", "patch0"], "patch0"
-        outer = ("coarse", _node_at(meshes.coarse, (b, 0.0)))
-        inner = ("patch0", _node_at(meshes.patch, (a, 0.0)))
+        outer = ("coarse", _node_at(meshes.coarse, (b, *origin)))
+        inner = ("patch0", _node_at(meshes.patch, (a, *origin)))
     for block in blocks:
-        problem.add_dirichlet(block, lambda x: np.isclose(x[0], 0.0, atol=1e-12 * b), [0])
-        problem.add_dirichlet(block, lambda x: np.isclose(x[1], 0.0, atol=1e-12 * b), [1])
+        for axis in range(config.dim):  # the symmetry planes x_i = 0: u_i = 0
+            problem.add_dirichlet(
+                block, lambda x, i=axis: np.isclose(x[i], 0.0, atol=1e-12 * b), [axis]
+            )
     pressure, u_bore = config.load_pressure, config.inner_displacement
     if pressure is not None:
         problem.add_traction(lambda x, n: -pressure * n, where=_on_bore(a))
