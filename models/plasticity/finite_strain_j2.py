@@ -145,6 +145,7 @@ class FiniteStrainJ2:
         self._kernel_static: tuple | None = None  # contiguous inputs and scratch of the kernel
         self._ones: np.ndarray | None = None
         self._alpha_of: tuple | None = None  # (read-only weight, its checked broadcast)
+        self._assembler = None  # the tangent's sparse pattern, built at the first call
 
     def _measure_factor(self) -> np.ndarray:
         if self.kind == "axisymmetric":
@@ -259,18 +260,7 @@ class FiniteStrainJ2:
             When det F ≤ 0 (or is not finite) at a quadrature point, naming the cell.
         """
         state = self.initial_state() if state is None else state
-        if weight is None:  # the common case: one array of ones, made once
-            if self._ones is None:
-                self._ones = np.ones(self.shape)
-            alpha = self._ones
-        elif isinstance(weight, np.ndarray) and not weight.flags.writeable:
-            # a read-only weight array cannot change between steps: checked and broadcast
-            # once (an integrator passes the same one at every step)
-            if self._alpha_of is None or self._alpha_of[0] is not weight:
-                self._alpha_of = (weight, self.elastic.weight_at_quadrature(weight))
-            alpha = self._alpha_of[1]
-        else:
-            alpha = self.elastic.weight_at_quadrature(weight)
+        alpha = self._weight(weight)
         if state.plastic_work is None:  # a state built by hand: no work accumulated yet
             zeros = np.zeros(self.shape)
             state = PlasticState(state.cp_inv, state.eqps, state.kirchhoff, state.jacobian,
@@ -278,6 +268,48 @@ class FiniteStrainJ2:
         if self.backend == "numba":
             return self._internal_force_numba(u, state, alpha, dt)
         return self._internal_force_numpy(u, state, alpha, dt)
+
+    def _weight(self, weight: WeightLike) -> np.ndarray:
+        """α at the quadrature points (n_elems, n_qp)."""
+        if weight is None:  # the common case: one array of ones, made once
+            if self._ones is None:
+                self._ones = np.ones(self.shape)
+            return self._ones
+        if isinstance(weight, np.ndarray) and not weight.flags.writeable:
+            # a read-only weight array cannot change between steps: checked and broadcast
+            # once (an integrator passes the same one at every step)
+            if self._alpha_of is None or self._alpha_of[0] is not weight:
+                self._alpha_of = (weight, self.elastic.weight_at_quadrature(weight))
+            return self._alpha_of[1]
+        return self.elastic.weight_at_quadrature(weight)
+
+    # ------------------------------------------------------------------ tangent
+    def tangent(
+        self,
+        u: np.ndarray,
+        state: PlasticState | None = None,
+        weight: WeightLike = None,
+        dt: float | None = None,
+    ) -> sp.csr_matrix:
+        """Consistent tangent ∂f/∂u (N/m) of :meth:`internal_force` at ``u`` from the committed
+        ``state`` (capability ``"tangent"``), sparse (n_dofs, n_dofs), non-symmetric with F-bar.
+
+        The algorithmic tangent of the exponential-map return (Hencky elasticity, the slope of
+        the hardening law at the converged ε̄p) plus the geometric and F-bar terms
+        (:mod:`arlequin.models.plasticity.j2_tangent`), weighted by α like the force. ``dt``: as
+        in :meth:`internal_force` (a rate-dependent law's rate term; None: the force at a
+        vanishing rate, as the integrators evaluate it without a step). The bulk viscosity is
+        not differentiated (it vanishes without ``dt``).
+        """
+        from .j2_tangent import BlockAssembler, numpy_tangent
+
+        state = self.initial_state() if state is None else state
+        alpha = self._weight(weight)
+        u = self._checked_displacement(u)
+        if self._assembler is None:
+            self._assembler = BlockAssembler(self.kin.cell_dofs, self.kin.n_dofs)
+        return numpy_tangent(self.kin, self.material, self.fbar, u, state, alpha, dt,
+                             self._assembler)  # fmt: skip
 
     def _viscous_pressure(self, jbar: np.ndarray, jbar_old: np.ndarray, dt: float | None):
         """q (Pa) per cell, shape (n_elems, 1), of the bulk viscosity (0 where off/expanding)."""
