@@ -146,6 +146,7 @@ class FiniteStrainJ2:
         self._ones: np.ndarray | None = None
         self._alpha_of: tuple | None = None  # (read-only weight, its checked broadcast)
         self._assembler = None  # the tangent's sparse pattern, built at the first call
+        self._tangent_static: tuple | None = None  # the tangent kernel's inputs and scratch
 
     def _measure_factor(self) -> np.ndarray:
         if self.kind == "axisymmetric":
@@ -308,8 +309,42 @@ class FiniteStrainJ2:
         u = self._checked_displacement(u)
         if self._assembler is None:
             self._assembler = BlockAssembler(self.kin.cell_dofs, self.kin.n_dofs)
+        if self.backend == "numba":
+            return self._assembler.assemble(self._tangent_blocks_numba(u, state, alpha, dt))
         return numpy_tangent(self.kin, self.material, self.fbar, u, state, alpha, dt,
                              self._assembler)  # fmt: skip
+
+    def _tangent_blocks_numba(self, u, state, alpha, dt) -> np.ndarray:
+        """The per-cell tangent blocks from the compiled kernel (flagged cells raise)."""
+        from .j2_tangent_kernel import j2_tangent_kernel, tangent_scratch
+
+        kin, c = self.kin, np.ascontiguousarray
+        ne, nq = self.shape
+        nen = kin.grad.shape[0]
+        if self._tangent_static is None:
+            radius = kin.radius if kin.radius is not None else np.ones((ne, nq))
+            self._tangent_static = (
+                c(np.transpose(kin.cell_dofs, (2, 1, 0)), dtype=np.int64),
+                c(np.moveaxis(kin.grad, (0, 1), (2, 3))), c(np.moveaxis(kin.val, 0, -1)),
+                c(radius), c(kin.dv0), *tangent_scratch(nq, nen, self.dim),
+            )  # fmt: skip
+        dofs, grad, val, radius, dv0, *scratch = self._tangent_static
+        law = self.material.law
+        blocks = np.empty((ne, nen * self.dim, nen * self.dim))
+        flags = np.empty(ne, dtype=np.int64)
+        j2_tangent_kernel(
+            u, dofs, grad, val, radius, dv0, c(np.broadcast_to(alpha, (ne, nq)), dtype=float),
+            self.kind == "axisymmetric", self.fbar, self.material.bulk_modulus,
+            self.material.shear_modulus, int(law.kernel_code), law.kernel_params,
+            -1.0 if dt is None else float(dt), c(state.cp_inv), c(state.eqps), *scratch,
+            blocks, flags,
+        )  # fmt: skip
+        if np.any(flags):
+            cell = int(np.nonzero(flags)[0][0])
+            if flags[cell] == 1:
+                raise InvertedElementError(f"inverted or degenerate cell {cell}: det F <= 0")
+            raise StateError(f"J2 return map not converged in cell {cell}")
+        return blocks
 
     def _viscous_pressure(self, jbar: np.ndarray, jbar_old: np.ndarray, dt: float | None):
         """q (Pa) per cell, shape (n_elems, 1), of the bulk viscosity (0 where off/expanding)."""
