@@ -1,5 +1,8 @@
 """Finite-strain J2 elastoplasticity (Simo 1992), total Lagrangian, with an optional weight.
 
+Its consistent tangent: :mod:`arlequin.models.plasticity.j2_tangent` (numpy) and
+:mod:`arlequin.models.plasticity.j2_tangent_kernel` (numba).
+
 The model ties three pieces together: the Q1 kinematics with F-bar
 (:mod:`arlequin.models.plasticity.kinematics`), the J2 material point
 (:mod:`arlequin.models.plasticity.j2`: Hencky elasticity, exponential-map return, any hardening law
@@ -97,8 +100,11 @@ class FiniteStrainJ2:
     interleaved by node (``dim * node + component``); :meth:`mass` and :meth:`stiffness`
     (small-strain elastic, for stable-step estimates) come from a
     :class:`~arlequin.models.LinearElastic` on the same mesh and quadrature. Capabilities
-    (:mod:`arlequin.contract`): ``"critical_time_step"`` in the current configuration; no
-    ``"tangent"`` (explicit dynamics; implicit schemes refuse it, or use ``newton="initial"``).
+    (:mod:`arlequin.contract`): ``"critical_time_step"`` in the current configuration;
+    ``"tangent"``, the consistent tangent of :meth:`internal_force` (:meth:`tangent`: numpy
+    reference :mod:`arlequin.models.plasticity.j2_tangent`, compiled
+    :mod:`arlequin.models.plasticity.j2_tangent_kernel` on the numba backend), so the implicit
+    integrators run it with full Newton.
     ``uses_time_step`` is True when the state update needs the step (rate-dependent hardening,
     bulk viscosity): the integrators then pass ``dt=`` to :meth:`internal_force`.
     """

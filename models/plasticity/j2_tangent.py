@@ -27,7 +27,15 @@ K_{bj,ak} = Σ w₀ [L^{bj} : C : L^{ak} − τ : (L^{bj} L^{ak}) + p tr(L^{bj} 
 W = Σ w₀, P = Σ w₀ p, Δdiv̄_{bj,ak} = Σ Jw [div_bj div_ak − tr(L^{bj} L^{ak})] / Σ Jw
 − div̄_bj div̄_ak (Jw = J dV₀): the last term couples every node of the cell through J̄.
 Without F-bar: Σ w₀ [L^{bj} : C : L^{ak} + K div_bj div_ak − τ : (L^{bj} L^{ak})].
-Non-symmetric in general (F-bar, and the geometric terms of a non-symmetric τ-coupling).
+With this F-bar force (the variation of F̄, unlike the force ∫ τ(F̄) : ∇ₓδu of de Souza Neto et
+al. 1996, whose tangent is non-symmetric) and the exponential-map return (a closest-point
+projection in log strains) the force is the gradient of an incremental potential Σ w₀ ψ̃(F̄):
+the tangent is symmetric to round-off (``tests/test_finite_strain_tangent.py``); it is returned
+as a general CSR matrix all the same.
+
+Rate-dependent laws: with the step ``dt`` the slope of the consistency equation includes
+∂σ_y/∂ε̄̇p / Δt (the derivative of ``internal_force(..., dt=dt)``); without it, the law at a
+vanishing rate, as the force without ``dt``. The bulk viscosity is not differentiated.
 
 Per-cell dense blocks (n_nodes·dim)², computed over chunks of cells (vectorised, bounded
 memory), assembled into a CSR matrix whose pattern is built once (:class:`BlockAssembler`).
