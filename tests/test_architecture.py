@@ -176,6 +176,8 @@ KERNELS = {
     "arlequin.geometry.clip3d._clip_one",
     "arlequin.models.plasticity.j2_kernel.planar_j2_kernel",
     "arlequin.models.plasticity.j2_kernel_3d.solid_j2_kernel",
+    "arlequin.models.plasticity.j2_tangent_kernel.j2_tangent_kernel",
+    "arlequin.models.plasticity.j2_tangent_kernel._point_modulus",
 }
 
 

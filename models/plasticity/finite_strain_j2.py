@@ -1,5 +1,8 @@
 """Finite-strain J2 elastoplasticity (Simo 1992), total Lagrangian, with an optional weight.
 
+Its consistent tangent: :mod:`arlequin.models.plasticity.j2_tangent` (numpy) and
+:mod:`arlequin.models.plasticity.j2_tangent_kernel` (numba).
+
 The model ties three pieces together: the Q1 kinematics with F-bar
 (:mod:`arlequin.models.plasticity.kinematics`), the J2 material point
 (:mod:`arlequin.models.plasticity.j2`: Hencky elasticity, exponential-map return, any hardening law
@@ -97,8 +100,11 @@ class FiniteStrainJ2:
     interleaved by node (``dim * node + component``); :meth:`mass` and :meth:`stiffness`
     (small-strain elastic, for stable-step estimates) come from a
     :class:`~arlequin.models.LinearElastic` on the same mesh and quadrature. Capabilities
-    (:mod:`arlequin.contract`): ``"critical_time_step"`` in the current configuration; no
-    ``"tangent"`` (explicit dynamics; implicit schemes refuse it, or use ``newton="initial"``).
+    (:mod:`arlequin.contract`): ``"critical_time_step"`` in the current configuration;
+    ``"tangent"``, the consistent tangent of :meth:`internal_force` (:meth:`tangent`: numpy
+    reference :mod:`arlequin.models.plasticity.j2_tangent`, compiled
+    :mod:`arlequin.models.plasticity.j2_tangent_kernel` on the numba backend), so the implicit
+    integrators run it with full Newton.
     ``uses_time_step`` is True when the state update needs the step (rate-dependent hardening,
     bulk viscosity): the integrators then pass ``dt=`` to :meth:`internal_force`.
     """
@@ -145,6 +151,8 @@ class FiniteStrainJ2:
         self._kernel_static: tuple | None = None  # contiguous inputs and scratch of the kernel
         self._ones: np.ndarray | None = None
         self._alpha_of: tuple | None = None  # (read-only weight, its checked broadcast)
+        self._assembler = None  # the tangent's sparse pattern, built at the first call
+        self._tangent_static: tuple | None = None  # the tangent kernel's inputs and scratch
 
     def _measure_factor(self) -> np.ndarray:
         if self.kind == "axisymmetric":
@@ -259,18 +267,7 @@ class FiniteStrainJ2:
             When det F ≤ 0 (or is not finite) at a quadrature point, naming the cell.
         """
         state = self.initial_state() if state is None else state
-        if weight is None:  # the common case: one array of ones, made once
-            if self._ones is None:
-                self._ones = np.ones(self.shape)
-            alpha = self._ones
-        elif isinstance(weight, np.ndarray) and not weight.flags.writeable:
-            # a read-only weight array cannot change between steps: checked and broadcast
-            # once (an integrator passes the same one at every step)
-            if self._alpha_of is None or self._alpha_of[0] is not weight:
-                self._alpha_of = (weight, self.elastic.weight_at_quadrature(weight))
-            alpha = self._alpha_of[1]
-        else:
-            alpha = self.elastic.weight_at_quadrature(weight)
+        alpha = self._weight(weight)
         if state.plastic_work is None:  # a state built by hand: no work accumulated yet
             zeros = np.zeros(self.shape)
             state = PlasticState(state.cp_inv, state.eqps, state.kirchhoff, state.jacobian,
@@ -278,6 +275,82 @@ class FiniteStrainJ2:
         if self.backend == "numba":
             return self._internal_force_numba(u, state, alpha, dt)
         return self._internal_force_numpy(u, state, alpha, dt)
+
+    def _weight(self, weight: WeightLike) -> np.ndarray:
+        """α at the quadrature points (n_elems, n_qp)."""
+        if weight is None:  # the common case: one array of ones, made once
+            if self._ones is None:
+                self._ones = np.ones(self.shape)
+            return self._ones
+        if isinstance(weight, np.ndarray) and not weight.flags.writeable:
+            # a read-only weight array cannot change between steps: checked and broadcast
+            # once (an integrator passes the same one at every step)
+            if self._alpha_of is None or self._alpha_of[0] is not weight:
+                self._alpha_of = (weight, self.elastic.weight_at_quadrature(weight))
+            return self._alpha_of[1]
+        return self.elastic.weight_at_quadrature(weight)
+
+    # ------------------------------------------------------------------ tangent
+    def tangent(
+        self,
+        u: np.ndarray,
+        state: PlasticState | None = None,
+        weight: WeightLike = None,
+        dt: float | None = None,
+    ) -> sp.csr_matrix:
+        """Consistent tangent ∂f/∂u (N/m) of :meth:`internal_force` at ``u`` from the committed
+        ``state`` (capability ``"tangent"``), sparse (n_dofs, n_dofs), non-symmetric with F-bar.
+
+        The algorithmic tangent of the exponential-map return (Hencky elasticity, the slope of
+        the hardening law at the converged ε̄p) plus the geometric and F-bar terms
+        (:mod:`arlequin.models.plasticity.j2_tangent`), weighted by α like the force. ``dt``: as
+        in :meth:`internal_force` (a rate-dependent law's rate term; None: the force at a
+        vanishing rate, as the integrators evaluate it without a step). The bulk viscosity is
+        not differentiated (it vanishes without ``dt``).
+        """
+        from .j2_tangent import BlockAssembler, numpy_tangent
+
+        state = self.initial_state() if state is None else state
+        alpha = self._weight(weight)
+        u = self._checked_displacement(u)
+        if self._assembler is None:
+            self._assembler = BlockAssembler(self.kin.cell_dofs, self.kin.n_dofs)
+        if self.backend == "numba":
+            return self._assembler.assemble(self._tangent_blocks_numba(u, state, alpha, dt))
+        return numpy_tangent(self.kin, self.material, self.fbar, u, state, alpha, dt,
+                             self._assembler)  # fmt: skip
+
+    def _tangent_blocks_numba(self, u, state, alpha, dt) -> np.ndarray:
+        """The per-cell tangent blocks from the compiled kernel (flagged cells raise)."""
+        from .j2_tangent_kernel import j2_tangent_kernel, tangent_scratch
+
+        kin, c = self.kin, np.ascontiguousarray
+        ne, nq = self.shape
+        nen = kin.grad.shape[0]
+        if self._tangent_static is None:
+            radius = kin.radius if kin.radius is not None else np.ones((ne, nq))
+            self._tangent_static = (
+                c(np.transpose(kin.cell_dofs, (2, 1, 0)), dtype=np.int64),
+                c(np.moveaxis(kin.grad, (0, 1), (2, 3))), c(np.moveaxis(kin.val, 0, -1)),
+                c(radius), c(kin.dv0), *tangent_scratch(nq, nen, self.dim),
+            )  # fmt: skip
+        dofs, grad, val, radius, dv0, *scratch = self._tangent_static
+        law = self.material.law
+        blocks = np.empty((ne, nen * self.dim, nen * self.dim))
+        flags = np.empty(ne, dtype=np.int64)
+        j2_tangent_kernel(
+            u, dofs, grad, val, radius, dv0, c(np.broadcast_to(alpha, (ne, nq)), dtype=float),
+            self.kind == "axisymmetric", self.fbar, self.material.bulk_modulus,
+            self.material.shear_modulus, int(law.kernel_code), law.kernel_params,
+            -1.0 if dt is None else float(dt), c(state.cp_inv), c(state.eqps), *scratch,
+            blocks, flags,
+        )  # fmt: skip
+        if np.any(flags):
+            cell = int(np.nonzero(flags)[0][0])
+            if flags[cell] == 1:
+                raise InvertedElementError(f"inverted or degenerate cell {cell}: det F <= 0")
+            raise StateError(f"J2 return map not converged in cell {cell}")
+        return blocks
 
     def _viscous_pressure(self, jbar: np.ndarray, jbar_old: np.ndarray, dt: float | None):
         """q (Pa) per cell, shape (n_elems, 1), of the bulk viscosity (0 where off/expanding)."""
