@@ -227,7 +227,11 @@ class SystemOperators:
             f[b.dofs] += term.sign * (ft if p is None else p.T @ ft)
             if tangent:
                 if self.tangent_kind == "consistent":
-                    kt = sp.csr_matrix(term.model.tangent(ut, state, term.weight))
+                    if getattr(term.model, "uses_time_step", False):  # rates: the same dt
+                        kt = term.model.tangent(ut, state, term.weight, dt=dt)
+                    else:
+                        kt = term.model.tangent(ut, state, term.weight)
+                    kt = sp.csr_matrix(kt)
                 else:
                     kt = sp.csr_matrix(term.model.stiffness(term.weight))
                 kb = term.sign * (kt if p is None else (p.T @ kt @ p))
