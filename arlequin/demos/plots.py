@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:
-    from .sliding_block import SlidingBlockResult
+    from .sliding_block.run import SlidingBlockResult
     from .taylor_bar import TaylorBarResult
     from .two_bars import TwoBarsResult
     from .wave import WaveResult

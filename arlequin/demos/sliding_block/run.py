@@ -51,8 +51,8 @@ from typing import Any
 import numpy as np
 import skfem
 
-from ..io import DynamicRunWriter, JsonResult, ResultsFolder
-from ..models import (
+from ...io import DynamicRunWriter, JsonResult, ResultsFolder
+from ...models import (
     ContactSurface,
     CoulombContact,
     IsotropicElastic,
@@ -61,8 +61,8 @@ from ..models import (
     PlaneObstacle,
     RigidContactPair,
 )
-from ..problem.system import Block, BlockTerm, CoupledSystem
-from ..solvers import RayleighDamping, SmoothStep, solve
+from ...problem.system import Block, BlockTerm, CoupledSystem
+from ...solvers import RayleighDamping, SmoothStep, solve
 
 __all__ = ["DAMPING", "JSON_KEYS", "RAMP_TRANSITS", "SlidingBlockResult", "run_sliding_block"]
 
@@ -484,7 +484,7 @@ def run_sliding_block(
 
 
 def _write(folder: ResultsFolder, result: SlidingBlockResult, arr: dict) -> None:
-    from .plots import plot_sliding_block
+    from ..plots import plot_sliding_block
 
     cols = ["t", "mean_velocity", "slip_velocity", "friction_work", "contact_work",
             "damping_work", "total_energy", "fixed_point_iterations"]  # fmt: skip
