@@ -2,7 +2,8 @@
 
 Exact (a rigid block, the mean velocity = momentum / mass): under a top pressure p, launched at
 v0, the block decelerates at a = μ p / (ρ H) and stops at v0 / a; on an incline θ under gravity
-it sticks for tan θ < μ and slides at g (sin θ − μ cos θ) for tan θ > μ. The elastic block
+it sticks for tan θ < μ and slides at g (sin θ − μ cos θ) for tan θ > μ; launched at V at the end
+of the gravity ramp, v̄ = V + g (sin θ − μ cos θ) t until it stops. The elastic block
 vibrates about these (the shear waves of the friction onset), so the checks are on time
 averages (fits and moving means) over the run.
 """
@@ -17,7 +18,7 @@ import pytest
 import skfem
 
 from arlequin.cli.main import main
-from arlequin.demos.sliding_block import JSON_KEYS, run_sliding_block
+from arlequin.demos.sliding_block import JSON_KEYS, SlidingBlockConfig, run_sliding_block
 from arlequin.models import (
     ContactSurface,
     CoulombContact,
@@ -127,6 +128,103 @@ def test_incline_sliding_acceleration():
     assert r.energy_balance_error < 0.01
 
 
+def test_launch_under_gravity_decelerates_and_stops_at_the_exact_time():
+    # μ = 0.3 on a 5° incline, launched at V = 0.5 m/s at the end of the gravity ramp: exact
+    # v̄ = V − g (μ cos θ − sin θ) t, stop at V / (g (μ cos θ − sin θ)) = 2.3618 ms, then it
+    # sticks. g = 1e3 m/s² keeps the launch's shear waves small against V, as the pressure
+    # default does: r = μ g H cos θ / (c_s V) = 1.9e-3 (1.2e-3 there). Measured at g = 1e4
+    # (r = 0.019, 19 shear periods to the stop, shorter than the damping's 0.4 ms) the base sticks
+    # by turns near the stop and the block stops 14% late (6.6% at 4 cells across), still
+    # slipping after; at g = 1e5 (r = 0.19) it does not stop within 1.3 × the stop time: the
+    # elastic block, not the rigid one, hence this g.
+    g, theta, v0 = 1e3, 5.0, 0.5
+    th = math.radians(theta)
+    decel = g * (MU * math.cos(th) - math.sin(th))
+    r = run_sliding_block(friction=MU, gravity=g, incline=theta, velocity=v0, elements=2)
+    assert r.expected_acceleration == pytest.approx(-decel, rel=1e-12)
+    assert r.expected_stop_time == pytest.approx(v0 / decel, rel=1e-12)
+    # measured (2 cells across, 0.5% damping, the default 300 H/c_d ramp and t_end = 1.3 × the
+    # stop): rate −9.9e-6 (−5e-6 to −1.4e-5 with other ramps, t_end or 4 cells: 1e-3 is 70 ×
+    # the largest); stop +0.41% (+0.67% and +0.71% with a 0.1 ms ramp or t_end = 2.8 ms, +0.15%
+    # at 4 cells): the moving mean over one shear period 4H/c_s = 12.5 µs, 0.53% of the stop,
+    # sets its resolution, so 1% is two windows; sliding distance V²/(2a) +3.5e-5; slip after
+    # 1.1 × the stop 1e-19 m/s; energy balance 5.6e-4 (the launch's kinetic energy counted with
+    # the work of the loads)
+    assert r.acceleration == pytest.approx(r.expected_acceleration, rel=1e-3)
+    assert r.stop_time == pytest.approx(r.expected_stop_time, rel=0.01)
+    assert r.sliding_distance == pytest.approx(v0**2 / (2 * decel), rel=1e-3)
+    assert r.max_slip_after_stop <= 1e-6 * v0
+    assert r.slipping_steps_after_stop == 0.0
+    assert r.energy_balance_error < 0.01
+    # the launch at t = 0: the mean velocity jumps from rest to V there
+    t, v = np.asarray(r.t), np.asarray(r.mean_velocity)
+    assert abs(v[t <= 0.0][-1]) < 1e-6 * v0 and v[t > 0.0][0] == pytest.approx(v0, rel=1e-3)
+
+
+def test_launch_under_gravity_beyond_the_friction_angle_keeps_accelerating():
+    # 25° > atan μ = 16.7°: the block already slides down the ramp, then keeps accelerating at
+    # g (sin θ − μ cos θ) after the launch; measured over 1 ms (2 cells across): +9.6e-6 (the
+    # fit over the whole run after the launch; +2.7e-6 over 3 ms), energy balance 7.7e-4
+    g, theta = 1e3, 25.0
+    th = math.radians(theta)
+    r = run_sliding_block(friction=MU, gravity=g, incline=theta, velocity=0.5, elements=2,
+                          t_end=1e-3)  # fmt: skip
+    assert r.expected_acceleration == pytest.approx(g * (math.sin(th) - MU * math.cos(th)))
+    assert r.expected_stop_time is None and r.stop_time is None
+    assert r.acceleration == pytest.approx(r.expected_acceleration, rel=1e-3)
+    assert r.energy_balance_error < 0.01
+
+
+def test_cli_launches_under_gravity(tmp_path):
+    # --gravity with --velocity was refused before the launch under gravity; a tiny run
+    path = tmp_path / "launch.json"
+    code = main(["sliding-block", "--quiet", "--gravity", "1e3", "--incline", "5", "--velocity",
+                 "0.5", "--elements", "1", "--ramp-time", "1e-5", "--t-end", "2e-5", "--json",
+                 str(path)])  # fmt: skip
+    assert code == 0
+    data = json.loads(path.read_text())
+    assert data["velocity"] == 0.5 and data["gravity"] == 1e3 and data["pressure"] is None
+    th = math.radians(5.0)
+    decel = 1e3 * (MU * math.cos(th) - math.sin(th))
+    assert data["expected_acceleration"] == pytest.approx(-decel)
+    assert data["expected_stop_time"] == pytest.approx(0.5 / decel)
+    assert {"acceleration", "stop_time"} <= set(data)
+
+
+def test_a_bad_value_is_the_same_error_from_the_cli_and_python(tmp_path, capsys):
+    # a negative launch is refused under either loading, before any work: nothing written
+    with pytest.raises(ValueError) as python_error:
+        run_sliding_block(gravity=1e3, velocity=-0.5, out=tmp_path / "py")
+    out = tmp_path / "cli"
+    code = main(["sliding-block", "--quiet", "--gravity", "1e3", "--velocity", "-0.5", "--out",
+                 str(out)])  # fmt: skip
+    assert code == 2
+    assert str(python_error.value) in capsys.readouterr().err
+    assert "velocity" in str(python_error.value) and "-0.5" in str(python_error.value)
+    assert not (tmp_path / "py").exists() and not out.exists()
+    with pytest.raises(ValueError, match="velocity must be"):
+        SlidingBlockConfig(velocity=-1.0)
+
+
+def test_recorded_inputs_are_plain_json(tmp_path):
+    out = tmp_path / "run"
+    r = run_sliding_block(gravity=1e3, incline=5.0, velocity=0.5, elements=1, ramp_time=1e-5,
+                          t_end=1e-5, out=out)  # fmt: skip
+    names = [f.name for f, _ in SlidingBlockConfig.fields()]
+    assert json.loads(json.dumps(r.config)) == r.config and list(r.config) == names
+    # the loading-dependent defaults recorded resolved: the damping ratio, no pressure
+    assert r.config["damping"] == 0.005 and r.config["pressure"] is None
+    meta = json.loads((out / "results.json").read_text())
+    assert set(meta["inputs"]) == set(names)
+    assert meta["inputs"]["velocity"]["value"] == 0.5
+    assert meta["inputs"]["velocity"]["unit"] == "m/s"
+    assert meta["inputs"]["incline"]["unit"] == "deg"
+    # the CLI's defaults: at rest under gravity, 1 m/s and 1e5 Pa with the pressure loading
+    assert SlidingBlockConfig(gravity=10.0).inputs()["velocity"] == 0.0
+    assert SlidingBlockConfig().inputs()["velocity"] == 1.0
+    assert SlidingBlockConfig().inputs()["pressure"] == 1e5
+
+
 def test_frictionless_block_keeps_its_velocity():
     # no tangential force at all: the momentum along x is that of the launch to round-off
     # (measured 7e-12 m/s after 900 steps: the internal forces, of the size of p W, sum to zero
@@ -169,7 +267,8 @@ def test_bad_input_is_refused():
         solve(system, "newmark", n_steps=1, dt=1e-6, constraints=[con])
     for kwargs, match in (({"pressure": 1e5, "gravity": 10.0}, "one of pressure and gravity"),
                           ({"incline": 10.0}, "needs the gravity"),
-                          ({"gravity": 10.0}, "pressure loading only"),
+                          ({"gravity": 10.0, "velocity": -1.0}, "velocity must be"),
+                          ({"velocity": 0.0}, "pressure loading launches the block"),
                           ({"friction": -0.1}, "friction must be"),
                           ({"dim": 1}, "dim must be 2 or 3")):  # fmt: skip
         with pytest.raises(ValueError, match=match):

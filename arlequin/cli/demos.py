@@ -8,12 +8,12 @@ from __future__ import annotations
 import argparse
 
 from ..demos.pressure_vessel.config import PressureVesselConfig
+from ..demos.sliding_block.config import SlidingBlockConfig
 from .ball import add_ball_impact
 from .common import add_out as _add_out
 from .common import run_demo
 from .common import write_json as _write_json
-from .generate import add_demo
-from .sliding import add_sliding_block
+from .generate import add_demo, config_from_args
 from .taylor import add_taylor_bar
 
 __all__ = ["add_demos", "check_case", "demo_parser", "two_bars_options", "wave_options"]
@@ -25,7 +25,7 @@ def add_demos(sub) -> None:
     _add_two_bars(sub)
     _add_wave(sub)
     add_taylor_bar(sub)
-    add_sliding_block(sub)
+    add_demo(sub, SlidingBlockConfig)
     add_ball_impact(sub)
     add_demo(sub, PressureVesselConfig)
 
@@ -33,7 +33,12 @@ def add_demos(sub) -> None:
 def check_case(demo: str, args: argparse.Namespace) -> None:
     """The demo's own input checks on a parsed command line, nothing run or written (its run
     function with ``check_only=True``; the patch test's options are all choices and integers,
-    which the parser has checked). Raises the demo's ``ValueError``."""
+    which the parser has checked; a demo generated from its configuration makes the
+    configuration, whose checks run then). Raises the demo's ``ValueError``."""
+    config = getattr(args, "config", None)
+    if config is not None:
+        config_from_args(config, args)
+        return
     if demo == "two-bars":
         from ..demos.two_bars import run_two_bars
 
@@ -47,11 +52,6 @@ def check_case(demo: str, args: argparse.Namespace) -> None:
         from .taylor import run_options
 
         run_taylor_bar(**run_options(args), check_only=True)
-    elif demo == "sliding-block":
-        from ..demos.sliding_block import run_sliding_block
-        from .sliding import sliding_options
-
-        run_sliding_block(**sliding_options(args), check_only=True)
     elif demo == "ball-impact":
         from ..demos.ball_impact import run_ball_impact
         from .ball import ball_options

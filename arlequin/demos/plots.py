@@ -7,12 +7,11 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:
-    from .sliding_block import SlidingBlockResult
     from .taylor_bar import TaylorBarResult
     from .two_bars import TwoBarsResult
     from .wave import WaveResult
 
-__all__ = ["plot_sliding_block", "plot_taylor_bar", "plot_two_bars", "plot_wave"]
+__all__ = ["plot_taylor_bar", "plot_two_bars", "plot_wave"]
 
 
 def plot_two_bars(result: TwoBarsResult, path: str) -> None:
@@ -190,43 +189,4 @@ def plot_patch_test_error(meshes: dict, errors: dict, path: str, title: str = ""
     fig.suptitle(textwrap.fill(title, 110), fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
-    plt.close(fig)
-
-
-def plot_sliding_block(result: SlidingBlockResult, path: str) -> None:
-    """Mean velocity against the exact straight line, and the energies, against time (PNG)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    t = np.asarray(result.t) * 1e6
-    v = np.asarray(result.mean_velocity)
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.5))
-    ax1.plot(t, v, lw=1.0, label="mean velocity (momentum / mass)")
-    v0 = v[np.searchsorted(t, 0.0)] if t.size else 0.0
-    a = result.expected_acceleration
-    ts = np.linspace(0.0, t[-1], 200) if t.size else np.zeros(1)
-    line = v0 + a * ts * 1e-6 if result.expected_stop_time is None else np.maximum(
-        v0 + a * ts * 1e-6, 0.0)  # fmt: skip
-    ax1.plot(ts, line, "k--", lw=1.0, label="exact (rigid block)")
-    ax1.set_xlabel("t (µs)")
-    ax1.set_ylabel("m/s")
-    ax1.legend()
-    ax1.set_title(f"μ = {result.config.get('friction')}")
-    e = np.asarray(result.total_energy)
-    fw = -np.asarray(result.friction_work)
-    cw = -np.asarray(result.contact_work)
-    ax2.plot(t, e, label="kinetic + strain − W_ext")
-    ax2.plot(t, fw, label="friction dissipation D_f")
-    ax2.plot(t, cw, label="normal contact loss W_c")
-    dd = -np.asarray(result.damping_work) if result.damping_work else np.zeros_like(e)
-    if dd.any():
-        ax2.plot(t, dd, label="damping dissipation D_d")
-    ax2.plot(t, e + fw + cw + dd, "k", lw=1.0, label="sum (constant)")
-    ax2.set_xlabel("t (µs)")
-    ax2.set_ylabel("J")
-    ax2.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
     plt.close(fig)
