@@ -15,7 +15,7 @@ __all__ = ["run_sliding_block"]
 def run_sliding_block(
     dim: int = 2,
     friction: float = 0.3,
-    velocity: float | None = 1.0,
+    velocity: float | None = None,
     incline: float = 0.0,
     pressure: float | None = None,
     gravity: float | None = None,
@@ -42,9 +42,9 @@ def run_sliding_block(
         Coulomb coefficient μ (0: the frictionless model, no tangential rows).
     velocity : float or None
         Launch velocity V along x (m/s, ≥ 0): at t = 0 with the pressure loading; at the end of
-        the ramp under gravity (x downslope; 0: the block stays at rest on the incline). None:
-        the command line's default, 1 with the pressure loading, 0 under gravity. The default
-        1.0 launches the block under gravity too: give ``velocity=0`` for a block at rest.
+        the ramp under gravity (x downslope; 0: the block stays at rest on the incline). None
+        (the default, as on the command line): 1 m/s with the pressure loading, 0 under
+        gravity.
     incline : float
         Incline θ of the plane (degrees), gravity loading.
     pressure, gravity : float, optional
