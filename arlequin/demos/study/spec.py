@@ -22,8 +22,18 @@ else:  # pragma: no cover
 
 __all__ = ["DEMOS", "Case", "StudyError", "StudySpec", "load_spec"]
 
-#: The CLI demos a study can run.
-DEMOS = ("taylor-bar", "ball-impact", "sliding-block", "two-bars", "wave", "patch-test")
+#: The CLI demos a study can run: every subcommand of ``arlequin`` registered by
+#: :func:`arlequin.cli.demos.add_demos` (read once, when first needed).
+DEMOS: tuple[str, ...] = ()
+
+
+def _demos() -> tuple[str, ...]:
+    global DEMOS
+    if not DEMOS:
+        from ...cli.demos import demo_parser
+
+        DEMOS = tuple(demo_parser()[1])
+    return DEMOS
 
 
 class StudyError(ValueError):
@@ -161,7 +171,7 @@ def load_spec(spec: str | os.PathLike | Mapping[str, Any]) -> StudySpec:
         raise StudyError(f"unknown keys {unknown} in the study (keys: demo, parameters, cases)")
     demo = data.get("demo")
     if not isinstance(demo, str):
-        raise StudyError(f'the study needs demo = "<name>" (one of {list(DEMOS)}), got {demo!r}')
+        raise StudyError(f'the study needs demo = "<name>" (one of {list(_demos())}), got {demo!r}')
     params = dict(data.get("parameters", {}))
     if not isinstance(params, dict):
         raise StudyError("[parameters] must be a table of option = value or [values]")
@@ -182,8 +192,8 @@ def load_spec(spec: str | os.PathLike | Mapping[str, Any]) -> StudySpec:
     cases = [Case(i, c) for i, c in enumerate(combos)]
     if ":" in demo:
         _resolve(demo)  # importable
-    elif demo not in DEMOS:
-        raise StudyError(f'demo {demo!r} is not one of {list(DEMOS)} (or "module:function")')
+    elif demo not in _demos():
+        raise StudyError(f'demo {demo!r} is not one of {list(_demos())} (or "module:function")')
     else:
         parser = _subparser(demo)
         for case in cases:
