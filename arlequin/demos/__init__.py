@@ -2,8 +2,8 @@
 
 ``run_taylor_bar`` (the Taylor bar: Arlequin, uniform or graded), ``resume_taylor_bar`` (an
 interrupted one, from its checkpoint) and ``run_ball_impact`` (the ball striking a block) are
-re-exported here; the others live in their modules (``two_bars``, ``wave``, ``patch_test``,
-``block_impact``, ``cantilever``, ``sliding_block``).
+re-exported here; the others live in their packages or modules (``two_bars``, ``wave``,
+``patch_test``, ``block_impact``, ``cantilever``, ``sliding_block``).
 """
 
 from .ball_impact import BallImpactResult, run_ball_impact

@@ -19,9 +19,9 @@ from dataclasses import dataclass
 import numpy as np
 import skfem
 
-from ..models import IsotropicElastic, LinearElastic
-from ..problem.arlequin_problem import ArlequinProblem, Patch
-from ..solvers import solve_static
+from ...models import IsotropicElastic, LinearElastic
+from ...problem.arlequin_problem import ArlequinProblem, Patch
+from ...solvers import solve_static
 
 __all__ = ["Cantilever", "build_cantilever", "tri_grid"]
 
