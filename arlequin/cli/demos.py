@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 
+from ..demos.plate_with_hole.config import PlateWithHoleConfig
 from ..demos.pressure_vessel.config import PressureVesselConfig
 from .ball import add_ball_impact
 from .common import add_out as _add_out
@@ -28,6 +29,7 @@ def add_demos(sub) -> None:
     add_sliding_block(sub)
     add_ball_impact(sub)
     add_demo(sub, PressureVesselConfig)
+    add_demo(sub, PlateWithHoleConfig)
 
 
 def check_case(demo: str, args: argparse.Namespace) -> None:
