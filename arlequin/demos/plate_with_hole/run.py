@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from ...io import QuasiStaticRunWriter, ResultsFolder
-from ...solvers import NewtonError, QuasiStaticSolver, solve_quasi_static
+from ...solvers import NewtonError, QuasiStaticSolver
 from .config import PlateWithHoleConfig
 from .result import HISTORY_KEYS, UNITS, PlateWithHoleResult
 from .setup import PlateSetup, build, loaded_edge_average
@@ -62,16 +62,37 @@ class _Recorder:
         self.append(solver.t, solver.u, state.eqps, rec.iterations, rec.residuals)
 
 
-def first_yield(setup: PlateSetup, system: Any, yield_stress: float) -> tuple[float, np.ndarray]:
-    """The load factor of first yield (the elastic response is linear up to it: a probing step
-    gives σ_vm ∝ λ at every quadrature point of the J2 model) and the displacement at λ = 1
-    of the elastic response (m)."""
-    solver = QuasiStaticSolver(system, load=PROBE, steps=1)
+def _steps(config: PlateWithHoleConfig, setup: PlateSetup, system: Any, recorder: _Recorder,
+           listeners: list[Callable[[Any], Any]]) -> tuple[Any, float]:  # fmt: skip
+    """The load path: a probing elastic step (λ = 1e-3: σ_vm ∝ λ at every quadrature point of
+    the J2 model up to first yield, so it gives the load factor λ0 of first yield), the
+    elastic step to λ0, then ``config.steps`` equal steps to λ = 1, every one by Newton from
+    the last converged displacement and multipliers. Returns the solver and λ0."""
+    solver = QuasiStaticSolver(system, load=1.0, steps=config.steps)
+    solver.dt = PROBE
     solver.step()
     s = setup
-    state = solver.states[s.plastic_block][s.plastic_term]
-    vm = float(np.max(np.asarray(state.von_mises)))
-    return PROBE * yield_stress / vm, solver.u / PROBE
+    vm = float(np.max(np.asarray(solver.states[s.plastic_block][s.plastic_term].von_mises)))
+    lam0 = PROBE * config.yield_stress / vm
+    start = PROBE
+    if lam0 < 1.0:
+        solver.dt = lam0 - PROBE
+        rec = solver.step()
+        recorder.append(solver.t, solver.u, None, rec.iterations, rec.residuals)
+        start = lam0
+    solver.nominal = solver.dt = (1.0 - start) / config.steps
+    solver.min_step = solver.nominal / 2**10
+    while solver.status == "running":
+        try:
+            rec = solver.step()
+        except NewtonError as err:
+            err.result = solver.result(str(err))
+            raise
+        if rec is None:  # a limit load
+            break
+        for listener in listeners:
+            listener(solver)
+    return solver, lam0
 
 
 def run(config: PlateWithHoleConfig, out: str | None = None,
@@ -97,18 +118,13 @@ def run(config: PlateWithHoleConfig, out: str | None = None,
         listeners.append(lambda solver: progress(solver.t))
     recorder.append(0.0, np.zeros(system.n_dofs), None, 0, [])
     try:
-        lam0, u_unit = first_yield(setup, system, config.yield_stress)
-        t0 = 0.0
-        if lam0 < 1.0:  # the elastic state at first yield, then N equal steps to S
-            t0 = lam0
-            recorder.append(lam0, lam0 * u_unit, None, 0, [])
-        qs = solve_quasi_static(system, load=1.0, steps=config.steps, on_step=listeners, t0=t0,
-                                u0=t0 * u_unit)  # fmt: skip
+        solver, lam0 = _steps(config, setup, system, recorder, listeners)
     except NewtonError as err:
         if folder is not None:
             folder.add_results({"history": recorder.history}, UNITS)
             folder.finish("failed", str(err))
         raise
+    qs = solver.result()
     result = PlateWithHoleResult(
         history=recorder.history,
         wall_time_s=time.perf_counter() - start,
