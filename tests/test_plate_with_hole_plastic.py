@@ -28,6 +28,27 @@ def _relative(run, ref, key: str, start: int) -> np.ndarray:
     return np.array(run.history[key][start:]) / np.array(ref.history[key][start:]) - 1.0
 
 
+def test_graded_mesh_is_conforming_and_holds_the_patch():
+    """The graded mesh has no hanging node (its only boundary facets are the plate's: the hole,
+    the two symmetry lines and the two outer edges), and its first cells are the patch's."""
+    from arlequin.demos.plate_with_hole.meshes import (
+        graded_plate_mesh,
+        quarter_plate_mesh,
+        refine_projected,
+    )
+
+    a, w, n_theta, n_radial, levels, rings = 0.01, 0.1, 4, 12, 2, 7
+    mesh, zone = graded_plate_mesh(a, n_theta, n_radial, w, levels, rings)
+    coarse, ring, _ = quarter_plate_mesh(a, n_theta, n_radial, "quad", w)
+    patch = refine_projected(coarse, levels, a, cells=np.nonzero(ring < rings)[0])
+    assert np.array_equal(zone, np.arange(patch.nelements))
+    assert np.allclose(mesh.p[:, mesh.t[:, zone]], patch.p[:, patch.t])
+    n_ang = 2 * n_theta * 2**levels
+    radial = rings * 2**levels + (n_radial - rings)
+    assert len(mesh.boundary_facets()) == 2 * n_ang + 2 * radial
+    assert mesh.nelements == n_ang * radial
+
+
 @pytest.fixture(scope="module")
 def coarse_runs():
     """The default configuration at one level of refinement (1.3k-1.5k cells, 1-2 s each)."""
