@@ -8,7 +8,9 @@ free.
 The coarse mesh is structured in polar-like coordinates: node (i, j) lies on the segment from the
 hole point a (cos θ_j, sin θ_j) to a point of the outer edges (x = 5a for θ ≤ 45°, y = 5a beyond),
 at a geometrically graded fraction f_i of its length. Cell rings i = 0 … n_radial − 1 go outwards
-from the hole. Every hole node lies on the circle.
+from the hole. Every hole node lies on the circle. The mesh functions live in
+:mod:`arlequin.demos.plate_with_hole.meshes` (shared with the elastoplastic demo
+``arlequin plate-with-hole``).
 
 Two runs at the same resolution near the hole:
 
@@ -48,135 +50,17 @@ import time
 import numpy as np
 import skfem
 
-from arlequin.coupling.patches import refine_region
+from arlequin.demos.plate_with_hole.meshes import (
+    hole_nodes,
+    project_hole_nodes,
+    quarter_plate_mesh,
+    refine_projected,
+)
 from arlequin.models import IsotropicElastic, LinearElastic
 from arlequin.problem.arlequin_problem import ArlequinProblem, Patch
 from arlequin.solvers.static import solve_static
 
-__all__ = ["project_hole_nodes", "quarter_plate_mesh", "refine_projected", "run"]
-
-
-def _grading(n: int, first: float) -> np.ndarray:
-    """Fractions 0 = f_0 < … < f_n = 1 with geometric spacing whose first step is ``first``.
-
-    Parameters
-    ----------
-    n : int
-        Number of steps.
-    first : float
-        First step as a fraction of the total, in (0, 1/n]: 1/n gives a uniform spacing.
-    """
-    if first * n >= 1.0 - 1e-12:
-        return np.linspace(0.0, 1.0, n + 1)
-    lo, hi = 1.0 + 1e-12, 10.0
-    for _ in range(200):  # bisection on the ratio q: first (q^n - 1) / (q - 1) = 1
-        q = 0.5 * (lo + hi)
-        if first * (q**n - 1.0) / (q - 1.0) > 1.0:
-            hi = q
-        else:
-            lo = q
-    steps = first * q ** np.arange(n)
-    f = np.concatenate([[0.0], np.cumsum(steps)])
-    return f / f[-1]
-
-
-def quarter_plate_mesh(
-    a: float = 1.0,
-    n_theta: int = 8,
-    n_radial: int = 12,
-    element: str = "tri",
-) -> tuple[skfem.Mesh, np.ndarray, np.ndarray]:
-    """Structured mesh of the quarter plate [0, 5a]² minus the quarter disc r < a.
-
-    Parameters
-    ----------
-    a : float
-        Hole radius (m).
-    n_theta : int
-        Cells along each 45° sector of the hole (2 n_theta along the quarter circle).
-    n_radial : int
-        Cell rings from the hole to the outer edges, geometrically graded so that the first ring
-        is about as deep as the cells are wide on the hole.
-    element : {"tri", "quad"}
-        Triangles (each quad split along its diagonal) or bilinear quadrilaterals.
-
-    Returns
-    -------
-    mesh : skfem.MeshTri or skfem.MeshQuad
-    ring : ndarray of int, shape (n_cells,)
-        Ring index (0 next to the hole) of each cell.
-    radii : ndarray, shape (n_radial + 1,)
-        x coordinate (m) of the ring boundaries on the x axis (θ = 0), from a to 5a.
-    """
-    if element not in ("tri", "quad"):
-        raise ValueError(f"element must be 'tri' or 'quad', got {element!r}")
-    n_ang = 2 * n_theta
-    theta = np.linspace(0.0, 0.5 * np.pi, n_ang + 1)
-    inner = a * np.stack([np.cos(theta), np.sin(theta)])  # (2, n_ang + 1)
-    t = np.arange(n_ang + 1) / n_theta  # 0 … 2 along the outer edges
-    outer = 5.0 * a * np.stack([np.minimum(2.0 - t, 1.0), np.minimum(t, 1.0)])
-    # first ring about as deep as the hole cells are wide (on the x axis, length 4a)
-    f = _grading(n_radial, min((0.25 * np.pi * a / n_theta) / (4.0 * a), 1.0 / n_radial))
-    p = inner[:, None, :] + f[None, :, None] * (outer - inner)[:, None, :]  # (2, i, j)
-    p = p.reshape(2, -1)
-    node = np.arange((n_radial + 1) * (n_ang + 1)).reshape(n_radial + 1, n_ang + 1)
-    v00, v10 = node[:-1, :-1].ravel(), node[1:, :-1].ravel()
-    v11, v01 = node[1:, 1:].ravel(), node[:-1, 1:].ravel()
-    ring = np.repeat(np.arange(n_radial), n_ang)
-    if element == "quad":
-        mesh = skfem.MeshQuad(p, np.stack([v00, v10, v11, v01]))
-    else:
-        t1 = np.stack([v00, v10, v11])
-        t2 = np.stack([v00, v11, v01])
-        mesh = skfem.MeshTri(p, np.concatenate([t1, t2], axis=1))
-        ring = np.concatenate([ring, ring])
-    return mesh, ring, a + 4.0 * a * f
-
-
-def hole_nodes(mesh: skfem.Mesh, a: float) -> np.ndarray:
-    """Nodes of the boundary facets lying on the hole (chords of the circle r = a).
-
-    A facet is on the hole when its midpoint is not farther than a from the origin (a chord's
-    midpoint lies inside the circle; facets on the symmetry axes leave the circle).
-    """
-    bf = mesh.boundary_facets()
-    mid = mesh.p[:, mesh.facets[:, bf]].mean(axis=1)
-    on_hole = np.linalg.norm(mid, axis=0) <= a * (1.0 + 1e-9)
-    return np.unique(mesh.facets[:, bf[on_hole]])
-
-
-def project_hole_nodes(mesh: skfem.Mesh, a: float) -> skfem.Mesh:
-    """The mesh with its hole nodes moved radially onto the circle r = a (m)."""
-    nodes = hole_nodes(mesh, a)
-    p = mesh.p.copy()
-    p[:, nodes] *= a / np.linalg.norm(p[:, nodes], axis=0)
-    return type(mesh)(p, mesh.t)
-
-
-def refine_projected(
-    mesh: skfem.Mesh, levels: int, a: float, cells: np.ndarray | None = None
-) -> skfem.Mesh:
-    """Refine (the given cells of) ``mesh`` one level at a time, projecting hole nodes each time.
-
-    Parameters
-    ----------
-    mesh : skfem.Mesh
-    levels : int
-        Uniform refinement levels.
-    a : float
-        Hole radius (m).
-    cells : ndarray of int, optional
-        Cells of ``mesh`` to keep and refine (default all): the patch region.
-
-    Returns
-    -------
-    skfem.Mesh
-    """
-    cells = np.arange(mesh.nelements) if cells is None else np.asarray(cells)
-    out = refine_region(mesh, levels=0, cells=cells)
-    for _ in range(levels):
-        out = project_hole_nodes(refine_region(out, levels=1, cells=np.arange(out.nelements)), a)
-    return out
+__all__ = ["hole_nodes", "project_hole_nodes", "quarter_plate_mesh", "refine_projected", "run"]
 
 
 def _node_at(mesh: skfem.Mesh, x: np.ndarray) -> int:

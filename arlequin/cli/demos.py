@@ -8,6 +8,7 @@ from __future__ import annotations
 import argparse
 
 from ..demos.patch_test.config import PatchTestConfig
+from ..demos.plate_with_hole.config import PlateWithHoleConfig
 from ..demos.pressure_vessel.config import PressureVesselConfig
 from ..demos.sliding_block.config import SlidingBlockConfig
 from ..demos.two_bars.config import TwoBarsConfig
@@ -28,6 +29,7 @@ def add_demos(sub) -> None:
     add_demo(sub, SlidingBlockConfig)
     add_ball_impact(sub)
     add_demo(sub, PressureVesselConfig)
+    add_demo(sub, PlateWithHoleConfig)
 
 
 def check_case(demo: str, args: argparse.Namespace) -> None:

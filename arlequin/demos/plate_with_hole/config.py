@@ -1,0 +1,152 @@
+"""The configuration of the plate-with-hole demo: the single source of its options."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+from ..config import DemoConfig, check_choice, check_positive, check_range, option
+
+__all__ = ["DEFAULT_LOAD", "MATERIALS", "MAX_LEVELS", "MODELS", "PlateWithHoleConfig"]
+
+MODELS = ("arlequin", "mono", "graded")
+MATERIALS = ("small-strain", "finite-strain")
+#: More levels than this would make the fine meshes of millions of cells.
+MAX_LEVELS = 5
+#: The default remote traction S (Pa): the plastic zone then reaches about 2.5 hole radii
+#: from the hole's centre (see :mod:`arlequin.demos.plate_with_hole`).
+DEFAULT_LOAD = 195e6
+
+
+def _count(name: str, value: Any, low: int, high: int | None = None) -> None:
+    ok = not isinstance(value, bool) and isinstance(value, (int, float)) and int(value) == value
+    ok = ok and value >= low and (high is None or value <= high)
+    if not ok:
+        span = f">= {low}" if high is None else f"in [{low}, {high}]"
+        raise ValueError(f"{name} must be an integer {span}, got {name}={value!r}")
+
+
+@dataclass(frozen=True)
+class PlateWithHoleConfig(DemoConfig):
+    """A quarter of a plane-strain plate with a hole pulled past first yield, J2 plasticity
+    (see :mod:`arlequin.demos.plate_with_hole`)."""
+
+    command: ClassVar[str] = "plate-with-hole"
+    title: ClassVar[str] = (
+        "plate with a hole pulled past first yield: coarse elastic plate + J2 patch around the "
+        "hole, against one fine mesh and a graded mesh (quasi-static, Newton)"
+    )
+    description: ClassVar[str] = (
+        "A quarter of a plane-strain plate 2W x 2W with a hole of radius A (symmetry on x = 0 "
+        "and y = 0) pulled by a uniform traction --load on x = W, loaded to first yield and "
+        "then in --steps equal steps solved by Newton with consistent tangents. --model "
+        "arlequin: a coarse linear-elastic model of the plate and a J2 patch of the coarse "
+        "rings around the hole refined --levels times; --model mono: the whole coarse mesh "
+        "refined --levels times, J2 everywhere; --model graded: one conforming mesh, the "
+        "patch's cells around the hole (J2) and the other rings split angularly only "
+        "(elastic). SI units."
+    )
+
+    model: str = option("arlequin", "coarse elastic + J2 patch, one fine mesh, or a graded mesh",
+                        "", choices=MODELS)  # fmt: skip
+    material: str = option("small-strain", "J2 at small strain or at finite strain", "",
+                           choices=MATERIALS)  # fmt: skip
+    load: float = option(DEFAULT_LOAD, "final remote traction S on x = W", "Pa", metavar="S")
+    steps: int = option(10, "equal load steps from first yield to S (cut where Newton needs)",
+                        "1", metavar="N")  # fmt: skip
+    levels: int = option(2, "refinement levels of the patch (and of the fine meshes)", "1",
+                         metavar="L")  # fmt: skip
+    radius: float = option(0.01, "hole radius a", "m", metavar="A")
+    half_width: float | None = option(None, "the plate's half width W (>= 10a)", "m",
+                                      metavar="W", default_help="10a")  # fmt: skip
+    young: float = option(210e9, "Young's modulus E", "Pa", metavar="E")
+    poisson: float = option(0.3, "Poisson's ratio", "1", metavar="NU")
+    yield_stress: float = option(240e6, "yield stress", "Pa", flag="--yield", metavar="SY")
+    hardening: float = option(0.0, "linear isotropic hardening modulus (0: perfectly plastic)",
+                              "Pa", metavar="H")  # fmt: skip
+    n_theta: int = option(8, "coarse cells along each 45 degrees of the hole", "1",
+                          metavar="N")  # fmt: skip
+    n_radial: int = option(24, "coarse rings from the hole to the edges (geometric)", "1",
+                           metavar="N")  # fmt: skip
+    gluing_rings: int = option(1, "the gluing band: the patch's outermost coarse rings", "1",
+                               metavar="N")  # fmt: skip
+    coupling: str = option("L2", "the mediator's coupling (H1 glues the band's gradients too)",
+                           "", choices=("L2", "H1"))  # fmt: skip
+    patch_radius: float | None = option(
+        None, "the patch: the coarse rings whose outer edge on the x axis is within this "
+        "distance of the centre", "m", metavar="RP", default_help="5a",
+    )  # fmt: skip
+
+    # -- resolved values ---------------------------------------------------------------------
+    @property
+    def width(self) -> float:
+        """W (m): the quarter plate is [0, W]²."""
+        return 10.0 * self.radius if self.half_width is None else self.half_width
+
+    @property
+    def patch_extent(self) -> float:
+        """The requested patch radius (m) on the x axis."""
+        return 5.0 * self.radius if self.patch_radius is None else self.patch_radius
+
+    # -- checks ------------------------------------------------------------------------------
+    def check(self) -> None:
+        check_choice("model", self.model, MODELS)
+        check_choice("material", self.material, MATERIALS)
+        check_choice("coupling", self.coupling, ("L2", "H1"))
+        check_positive("load", self.load, "Pa")
+        _count("steps", self.steps, 1)
+        _count("levels", self.levels, 0, MAX_LEVELS)
+        check_positive("radius", self.radius, "m")
+        check_positive("half_width", self.half_width, "m", allow_none=True)
+        if self.width < 10.0 * self.radius * (1.0 - 1e-12):
+            raise ValueError(
+                f"half_width={self.width} m must be at least 10 hole radii ({10 * self.radius} "
+                "m): the plate is at least 20 hole radii across, its far field uniform"
+            )
+        check_positive("young", self.young, "Pa")
+        check_range("poisson", self.poisson, -1.0, 0.5, closed="()")
+        check_positive("yield_stress", self.yield_stress, "Pa")
+        check_positive("hardening", self.hardening, "Pa", allow_zero=True)
+        _count("n_theta", self.n_theta, 1)
+        _count("n_radial", self.n_radial, 3)
+        check_positive("patch_radius", self.patch_radius, "m", allow_none=True)
+        if self.model != "mono":
+            from .meshes import ring_fractions
+
+            f = ring_fractions(self.radius, self.n_theta, self.n_radial, self.width)
+            radii = self.radius + (self.width - self.radius) * f
+            rings = int((radii[1:] <= self.patch_extent * (1.0 + 1e-12)).sum())
+            _count("gluing_rings", self.gluing_rings, 1)
+            if not self.gluing_rings < rings < self.n_radial:
+                raise ValueError(
+                    f"patch_radius={self.patch_extent} m must cover more coarse rings than the "
+                    f"gluing band's {self.gluing_rings} (to {radii[self.gluing_rings + 1]:.4g} m) "
+                    f"and leave one outside (below {radii[-2]:.4g} m)"
+                )
+        if self.material == "finite-strain":
+            from ...models import FiniteStrainJ2
+
+            if not callable(getattr(FiniteStrainJ2, "tangent", None)):
+                raise ValueError(
+                    "material='finite-strain' needs the consistent tangent of FiniteStrainJ2, "
+                    "which this version does not have: use material='small-strain'"
+                )
+
+    @property
+    def patch_rings(self) -> int:
+        """The coarse rings of the patch (or of the graded mesh's fine zone)."""
+        from .meshes import ring_fractions
+
+        f = ring_fractions(self.radius, self.n_theta, self.n_radial, self.width)
+        radii = self.radius + (self.width - self.radius) * f
+        return int((radii[1:] <= self.patch_extent * (1.0 + 1e-12)).sum())
+
+    def progress_scale(self) -> tuple[float, str, float, str]:
+        return 100.0, "%", 100.0, f"{self.command} ({self.model})"
+
+    # -- running -----------------------------------------------------------------------------
+    def run(self, out: str | None = None, progress: Callable[[float], None] | None = None) -> Any:
+        from .run import run
+
+        return run(self, out=out, progress=progress)

@@ -1,0 +1,82 @@
+"""The result of a plate-with-hole run: its JSON keys (the Interface), units and summary."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from ...io import JsonResult
+
+__all__ = ["HISTORY_KEYS", "JSON_KEYS", "UNITS", "PlateWithHoleResult"]
+
+#: The Interface's keys, in order.
+JSON_KEYS = ("history", "wall_time_s", "n_elements", "patch_fraction")
+#: The keys of ``history``: one value per converged state (the initial state first, then
+#: first yield, then every load step). The Interface's three first.
+HISTORY_KEYS = ("load", "displacement", "plastic_area", "plastic_extent", "newton_iterations",
+                "residuals")  # fmt: skip
+UNITS = {
+    "load": "Pa",
+    "displacement": "m",
+    "plastic_area": "m^2",
+    "plastic_extent": "m",
+    "newton_iterations": "1",
+    "residuals": "1",
+    "wall_time_s": "s",
+    "n_elements": "1",
+    "n_dofs": "1",
+    "patch_fraction": "1",
+    "first_yield_load": "Pa",
+}
+
+
+@dataclass
+class PlateWithHoleResult(JsonResult):
+    """What a plate-with-hole run computed (SI units).
+
+    Attributes
+    ----------
+    history : dict
+        Per converged state (the unloaded plate first, then first yield, then each load step):
+        ``load`` S (Pa); ``displacement`` the mean x-displacement of the loaded edge x = W (m);
+        ``plastic_area`` the area of the quadrature-point weights with ε̄p > 0 over the quarter
+        plate (m²); ``plastic_extent`` the largest distance from the hole's centre of a
+        quadrature point with ε̄p > 0 (m, 0 before yield); ``newton_iterations`` and
+        ``residuals`` (each step's relative residuals; 0 and [] for the first two states).
+    wall_time_s : float
+        The run's wall time (s): meshes, models, the elastic solve, the load steps.
+    n_elements : int
+        Cells of the run (every model's).
+    patch_fraction : float
+        The J2 region's share of the quarter plate's area (1 for ``mono``).
+    n_dofs : int
+    first_yield_load : float
+        The remote traction S at which the first quadrature point yields (Pa).
+    status : str
+        The quasi-static solver's end: ``completed`` or ``limit_load``.
+    """
+
+    history: dict[str, list[Any]]
+    wall_time_s: float
+    n_elements: int
+    patch_fraction: float
+    n_dofs: int = 0
+    first_yield_load: float = 0.0
+    status: str = "completed"
+    config: dict[str, Any] = field(default_factory=dict)
+
+    json_exclude = ("config",)
+
+    def summary(self) -> str:
+        """One line: the final state and Newton."""
+        h = self.history
+        its = h["newton_iterations"][2:]
+        a = self.config.get("radius") or 1.0
+        return (
+            f"plate with a hole ({self.config.get('model')}): first yield "
+            f"{self.first_yield_load / 1e6:.2f} MPa, S = {h['load'][-1] / 1e6:.2f} MPa: edge "
+            f"displacement {h['displacement'][-1] * 1e6:.4f} um, plastic area "
+            f"{h['plastic_area'][-1] * 1e6:.4f} mm^2, extent {h['plastic_extent'][-1] / a:.3f} a; "
+            f"{len(its)} steps, Newton {sum(its)} iterations (max {max(its, default=0)}), "
+            f"{self.n_elements} cells, {self.wall_time_s:.1f} s ({self.status})"
+        )

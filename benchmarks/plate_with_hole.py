@@ -1,0 +1,143 @@
+"""Benchmark: the plate with a hole (``arlequin plate-with-hole``), its three models in one
+process (issue 29, item 6).
+
+Runs ``mono`` (the whole coarse mesh refined, J2 everywhere), ``arlequin`` (coarse elastic plate
++ J2 patch) and ``graded`` (one conforming mesh, J2 on the patch's cells) at the same
+configuration, ``--repeat`` rounds each (the shortest wall time kept), and prints JSON: wall
+times, Newton iterations, cells and dofs, T_mono / T_arlequin (target ≥ 10), T_arlequin /
+T_graded (target ≤ 1.5), each run's split of its time (constitutive update, tangent assembly,
+factorisation and the solves of the Newton systems, the rest), the largest Newton contraction
+r_k+1 / r_k² below 1e-3, the accuracy against mono, and each model's peak traced memory (one
+more run under :mod:`tracemalloc`).
+
+    python benchmarks/plate_with_hole.py [--levels 2] [--steps 10] [--repeat 1]
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import json
+import time
+import tracemalloc
+from contextlib import contextmanager
+
+import _threads  # before numba runs: OpenMP threads sleep between parallel regions
+import numpy as np
+import scipy.sparse.linalg as spla
+
+from arlequin.demos.plate_with_hole import run_plate_with_hole
+from arlequin.models import SmallStrainJ2
+from arlequin.solvers import condensation
+
+MODELS = ("mono", "arlequin", "graded")
+
+
+@contextmanager
+def timed_split():
+    """Wall time spent in the J2 return and force, its tangent's assembly, SuperLU's
+    factorisation and the triangular solves, by wrapping those functions (restored after)."""
+    split = {"constitutive_update": 0.0, "tangent_assembly": 0.0, "factorisation": 0.0,
+             "solves": 0.0}  # fmt: skip
+    originals = [(SmallStrainJ2, "internal_force"), (SmallStrainJ2, "tangent"),
+                 (spla, "splu"), (condensation, "_factor_solve")]  # fmt: skip
+    saved = [getattr(owner, name) for owner, name in originals]
+
+    def wrap(fn, key):
+        def inner(*args, **kwargs):
+            t = time.perf_counter()
+            try:
+                return fn(*args, **kwargs)
+            finally:
+                split[key] += time.perf_counter() - t
+
+        return inner
+
+    SmallStrainJ2.internal_force = wrap(saved[0], "constitutive_update")
+    SmallStrainJ2.tangent = wrap(saved[1], "tangent_assembly")
+    spla.splu = wrap(saved[2], "factorisation")
+    condensation._factor_solve = wrap(saved[3], "solves")
+    try:
+        yield split
+    finally:
+        for (owner, name), fn in zip(originals, saved):
+            setattr(owner, name, fn)
+        # the factorisation ran inside _factor_solve: the solves are the rest of it
+        split["solves"] -= split["factorisation"]
+
+
+def max_contraction(residuals) -> float:
+    """The largest r_k+1 / r_k² over the Newton iterations with r_k < 1e-3 and r_k+1 > 1e-10
+    (issue 29, item 5: at most 10)."""
+    worst = 0.0
+    for res in residuals:
+        for r0, r1 in itertools.pairwise(res):
+            if r0 < 1e-3 and r1 > 1e-10:
+                worst = max(worst, r1 / r0**2)
+    return worst
+
+
+def bench(levels: int, steps: int, repeat: int, memory: bool) -> dict:
+    out: dict = {"levels": levels, "steps": steps, "repeat": repeat, "models": {}}
+    out["threads"] = _threads.settings()
+    results = {}
+    for model in MODELS:
+        best, split = None, None
+        for _ in range(repeat):
+            with timed_split() as s:
+                t = time.perf_counter()
+                r = run_plate_with_hole(model=model, levels=levels, steps=steps)
+                wall = time.perf_counter() - t
+            if best is None or wall < best:
+                best, split = wall, dict(s)
+        results[model] = r
+        split["rest"] = best - sum(split.values())
+        its = r.history["newton_iterations"][2:]
+        out["models"][model] = {
+            "wall_time_s": best,
+            "split_s": split,
+            "newton_iterations": int(sum(its)),
+            "newton_max_per_step": int(max(its)),
+            "newton_max_contraction": max_contraction(r.history["residuals"]),
+            "n_elements": r.n_elements,
+            "n_dofs": r.n_dofs,
+            "patch_fraction": r.patch_fraction,
+            "first_yield_load_Pa": r.first_yield_load,
+            "final_displacement_m": r.history["displacement"][-1],
+            "final_plastic_area_m2": r.history["plastic_area"][-1],
+            "final_plastic_extent_m": r.history["plastic_extent"][-1],
+        }
+        if memory:
+            tracemalloc.start()
+            run_plate_with_hole(model=model, levels=levels, steps=steps)
+            out["models"][model]["peak_traced_memory_MB"] = tracemalloc.get_traced_memory()[1] / 1e6
+            tracemalloc.stop()
+    ref = results["mono"].history
+    for model in ("arlequin", "graded"):
+        h = results[model].history
+        d = np.array(h["displacement"][1:]) / np.array(ref["displacement"][1:]) - 1.0
+        out["models"][model]["max_displacement_deviation_from_mono"] = float(np.abs(d).max())
+        out["models"][model]["plastic_area_deviation_from_mono"] = float(
+            h["plastic_area"][-1] / ref["plastic_area"][-1] - 1.0
+        )
+    t = {m: out["models"][m]["wall_time_s"] for m in MODELS}
+    out["T_mono_over_T_arlequin"] = t["mono"] / t["arlequin"]
+    out["T_arlequin_over_T_graded"] = t["arlequin"] / t["graded"]
+    out["targets"] = {"T_mono_over_T_arlequin": ">= 10", "T_arlequin_over_T_graded": "<= 1.5"}
+    return out
+
+
+def main(argv=None) -> dict:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--levels", type=int, default=2)
+    parser.add_argument("--steps", type=int, default=10)
+    parser.add_argument("--repeat", type=int, default=1)
+    parser.add_argument("--no-memory", action="store_true", help="skip the tracemalloc runs")
+    args = parser.parse_args(argv)
+    out = bench(args.levels, args.steps, args.repeat, not args.no_memory)
+    print(json.dumps(out, indent=2))
+    return out
+
+
+if __name__ == "__main__":
+    main()
