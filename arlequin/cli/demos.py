@@ -7,10 +7,11 @@ from __future__ import annotations
 
 import argparse
 
-from .ball import add_ball_impact
+from ..demos.ball_impact.config import BallImpactConfig
 from .common import add_out as _add_out
 from .common import run_demo
 from .common import write_json as _write_json
+from .generate import add_demo, config_from_args
 from .sliding import add_sliding_block
 from .taylor import add_taylor_bar
 
@@ -24,13 +25,14 @@ def add_demos(sub) -> None:
     _add_wave(sub)
     add_taylor_bar(sub)
     add_sliding_block(sub)
-    add_ball_impact(sub)
+    add_demo(sub, BallImpactConfig)
 
 
 def check_case(demo: str, args: argparse.Namespace) -> None:
     """The demo's own input checks on a parsed command line, nothing run or written (its run
-    function with ``check_only=True``; the patch test's options are all choices and integers,
-    which the parser has checked). Raises the demo's ``ValueError``."""
+    function with ``check_only=True``, or, for a subcommand generated from a configuration,
+    the configuration made from the options; the patch test's options are all choices and
+    integers, which the parser has checked). Raises the demo's ``ValueError``."""
     if demo == "two-bars":
         from ..demos.two_bars import run_two_bars
 
@@ -49,11 +51,8 @@ def check_case(demo: str, args: argparse.Namespace) -> None:
         from .sliding import sliding_options
 
         run_sliding_block(**sliding_options(args), check_only=True)
-    elif demo == "ball-impact":
-        from ..demos.ball_impact import run_ball_impact
-        from .ball import ball_options
-
-        run_ball_impact(**ball_options(args), check_only=True)
+    elif getattr(args, "config", None) is not None:  # a generated subcommand
+        config_from_args(args.config, args)
 
 
 def demo_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.ArgumentParser]]:
