@@ -18,14 +18,13 @@ import skfem
 from arlequin import ArlequinProblem, MultiBodyProblem
 from arlequin.cli.main import main
 from arlequin.demos.ball_impact import STEEL, run_ball_impact
-from arlequin.demos.ball_meshes import (
+from arlequin.demos.ball_impact.meshes import (
     ball_patch_mesh,
     block_mesh,
     graded_coordinates,
     half_disk_mesh,
 )
-from arlequin.demos.ball_record import hertz_force_history
-from arlequin.demos.ball_result import JSON_KEYS, hertz
+from arlequin.demos.ball_impact.result import JSON_KEYS, hertz, hertz_force_history
 from arlequin.geometry.meshcheck import corner_jacobians
 from arlequin.models import IsotropicElastic, LinearElastic
 from arlequin.solvers import solve
@@ -245,7 +244,7 @@ def test_a_zoned_body_has_one_law_per_cell():
     # the elastic one on the nodes away from the zone and the J2 sub-mesh's, moved back to the
     # mesh's dofs, plus the elastic one of the other cells on the zone's nodes
     from arlequin.demos.ball_impact import COPPER
-    from arlequin.demos.ball_zoned import ZonedBody
+    from arlequin.demos.ball_impact.zoned import ZonedBody
     from arlequin.solvers.operators import SystemOperators
 
     mesh = skfem.MeshQuad.init_tensor(np.linspace(0, 0.01, 9), np.linspace(-0.01, 0, 9))
@@ -334,3 +333,54 @@ def test_plastic_regime_with_friction_against_the_uniform_mesh():
         assert r.energy_balance_error < 0.01
     # friction restrains the surface's radial flow: less plastic strain than without it (0.185)
     assert arl.max_plastic_strain < 0.175
+
+
+def test_the_recorded_inputs_are_plain_json(tmp_path):
+    # the inputs of results.json and of the JSON: every key as before, the materials as
+    # objects of their named fields (not a repr), the defaults resolved (velocity, patches)
+    from arlequin.demos.ball_impact import BallImpactConfig
+    from arlequin.demos.ball_impact.result import INPUT_UNITS
+
+    r = run_ball_impact(rigid_wall=True, out=tmp_path / "run", **ROUGH)
+    steel = {"young": 210e9, "poisson": 0.3, "density": 7850.0}
+    inputs = json.loads((tmp_path / "run" / "results.json").read_text())["inputs"]
+    assert list(inputs) == list(INPUT_UNITS)
+    assert inputs["ball_material"] == {"value": steel, "unit": ""}
+    assert inputs["velocity"] == {"value": 1.0, "unit": "m/s"}
+    assert inputs["patch_size"]["value"] == pytest.approx(0.2 * R)
+    data = json.loads(json.dumps(r.to_json()))
+    assert data["ball_material"] == steel and data["rigid_wall"] is True
+    assert data["coarse_step_ratio"] == 2
+    copper = BallImpactConfig(regime="plastic", block_young=100e9).inputs()["block_material"]
+    assert copper == {"young": 100e9, "poisson": 0.35, "density": 8930.0,
+                      "yield_stress": 0.4e9, "hardening_modulus": 0.1e9,
+                      "hardening": None}  # fmt: skip
+
+
+def test_a_bad_value_is_the_same_error_from_the_command_line_and_python(monkeypatch, capsys):
+    # the configuration checks every input: the same ValueError from run_ball_impact and from
+    # `arlequin ball-impact`, before any body is built
+    import arlequin.demos.ball_impact.run as run_module
+    from arlequin.demos.ball_impact import BallImpactConfig
+
+    def no_work(*args, **kwargs):
+        raise AssertionError("the bodies were built before the inputs were checked")
+
+    monkeypatch.setattr(run_module, "ImpactBodies", no_work)
+    for argv, kwargs in (
+        (["--velocity", "-1"], {"velocity": -1.0}),
+        (["--patch-size", str(0.9 * R)], {"patch_size": 0.9 * R}),
+        (["--model", "mono", "--coarse-step-ratio", "2"], {"model": "mono",
+                                                           "coarse_step_ratio": 2}),
+        (["--rigid-wall", "--block-young", "1e9"],
+         {"rigid_wall": True, "block_material": IsotropicElastic(1e9, 0.3, 7850.0)}),
+        (["--block-yield-stress", "1e8"], {"block_yield_stress": 1e8}),
+    ):  # fmt: skip
+        with pytest.raises(ValueError) as python:
+            if "block_yield_stress" in kwargs:  # an option of the configuration only
+                BallImpactConfig(**kwargs)
+            else:
+                run_ball_impact(**kwargs)
+        capsys.readouterr()
+        assert main(["ball-impact", "--quiet", *argv]) == 2
+        assert f"error: {python.value}" in capsys.readouterr().err, argv

@@ -19,7 +19,7 @@ import pytest
 import scipy.sparse as sp
 
 from arlequin.demos.ball_impact import STEEL
-from arlequin.demos.ball_setup import ImpactBodies, ball_sizes
+from arlequin.demos.ball_impact.setup import ImpactBodies, ball_sizes
 from arlequin.demos.patch_test import build_patch_test_problem
 from arlequin.problem.system import CoupledSystem, LinearConstraint
 from arlequin.solvers import solve

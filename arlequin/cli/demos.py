@@ -1,19 +1,19 @@
 """The demos' subcommands, registered in one place (:func:`add_demos`), shared by ``arlequin``
 and the study runner (:mod:`arlequin.demos.study`), which parses and runs a case exactly as
-the command line would. Every subcommand but taylor-bar and ball-impact is generated from its
-demo's configuration (:mod:`arlequin.cli.generate`)."""
+the command line would. Every subcommand but taylor-bar is generated from its demo's
+configuration (:mod:`arlequin.cli.generate`)."""
 
 from __future__ import annotations
 
 import argparse
 
+from ..demos.ball_impact.config import BallImpactConfig
 from ..demos.patch_test.config import PatchTestConfig
 from ..demos.plate_with_hole.config import PlateWithHoleConfig
 from ..demos.pressure_vessel.config import PressureVesselConfig
 from ..demos.sliding_block.config import SlidingBlockConfig
 from ..demos.two_bars.config import TwoBarsConfig
 from ..demos.wave.config import WaveConfig
-from .ball import add_ball_impact
 from .generate import add_demo, config_from_args
 from .taylor import add_taylor_bar
 
@@ -27,7 +27,7 @@ def add_demos(sub) -> None:
     add_demo(sub, WaveConfig)
     add_taylor_bar(sub)
     add_demo(sub, SlidingBlockConfig)
-    add_ball_impact(sub)
+    add_demo(sub, BallImpactConfig)
     add_demo(sub, PressureVesselConfig)
     add_demo(sub, PlateWithHoleConfig)
 
@@ -44,11 +44,6 @@ def check_case(demo: str, args: argparse.Namespace) -> None:
         from .taylor import run_options
 
         run_taylor_bar(**run_options(args), check_only=True)
-    elif demo == "ball-impact":
-        from ..demos.ball_impact import run_ball_impact
-        from .ball import ball_options
-
-        run_ball_impact(**ball_options(args), check_only=True)
 
 
 def demo_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.ArgumentParser]]:

@@ -16,9 +16,9 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from ..models import FiniteStrainJ2, J2Material, LinearElastic
-from ..problem.arlequin_problem import ArlequinProblem
-from ..problem.system import Block, BlockTerm, CoupledSystem
+from ...models import FiniteStrainJ2, J2Material, LinearElastic
+from ...problem.arlequin_problem import ArlequinProblem
+from ...problem.system import Block, BlockTerm, CoupledSystem
 
 __all__ = ["FrozenLinear", "ZonedBody"]
 

@@ -27,7 +27,7 @@ from __future__ import annotations
 import numpy as np
 import skfem
 
-from ..coupling.patches import refine_region
+from ...coupling.patches import refine_region
 
 __all__ = [
     "ball_patch_mesh",

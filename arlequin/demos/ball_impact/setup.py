@@ -1,8 +1,8 @@
 """The bodies of the ball-impact demo: the ball (and the block) as Arlequin pairs or single meshes.
 
 ``arlequin`` (:class:`ArlequinBodies`): each body is a coarse linear-elastic model of the whole
-body plus a nested refined patch at the contact zone (:mod:`arlequin.demos.ball_meshes`), glued
-by the fine mediator in a band of two coarse cells at the patch's edge, ramp weights (L2
+body plus a nested refined patch at the contact zone (:mod:`arlequin.demos.ball_impact.meshes`),
+glued by the fine mediator in a band of two coarse cells at the patch's edge, ramp weights (L2
 coupling: on a nested patch the fine mediator ties the band's fine dofs to the coarse field
 whatever the coupling, and the H1 rows make the impulse solve 2.2 times slower: measured 175 s
 against 78 s for the same results to 1e-6 on the rigid-wall run at 13 cells per contact
@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from ..models import (
+from ...models import (
     ContactSurface,
     CoulombContact,
     DeformableContactPair,
@@ -36,12 +36,12 @@ from ..models import (
     PlaneObstacle,
     RigidContactPair,
 )
-from ..problem.arlequin_problem import ArlequinProblem, Patch
-from ..problem.bodies import MultiBodyProblem
-from .ball_meshes import GROWTH, ball_patch_mesh, block_mesh, block_patch_mesh, half_disk_mesh
-from .ball_zoned import ZonedBody
+from ...problem.arlequin_problem import ArlequinProblem, Patch
+from ...problem.bodies import MultiBodyProblem
+from .meshes import GROWTH, ball_patch_mesh, block_mesh, block_patch_mesh, half_disk_mesh
+from .zoned import ZonedBody
 
-__all__ = ["ARC", "BallSizes", "ImpactBodies", "ball_sizes"]
+__all__ = ["ARC", "BallSizes", "ImpactBodies", "ResolvedInputs", "ball_sizes", "mono_cells"]
 
 #: Length of the ball's O-grid cells along its arc, per 1/n (m per m of radius).
 ARC = 0.25 * math.pi
@@ -90,6 +90,54 @@ def ball_sizes(radius: float, coarse_size: float, fine_size: float, reach: float
                      float(block_reach or 0.0))  # fmt: skip
 
 
+def mono_cells(sizes: BallSizes, block_radius: float, block_height: float,
+               rigid_wall: bool) -> int:  # fmt: skip
+    """Cells of the uniformly fine (``mono``) meshes of both bodies at ``sizes.fine``."""
+    n_f = sizes.n * 2**sizes.levels
+    cells = 6 * n_f**2
+    if not rigid_wall:
+        cells += math.ceil(block_radius / sizes.fine) * math.ceil(block_height / sizes.fine)
+    return int(cells)
+
+
+@dataclass(frozen=True)
+class ResolvedInputs:
+    """The inputs of a run with the defaults that depend on others resolved (SI units).
+
+    ``velocity`` (m/s), ``radius`` (R, m), ``block_radius``, ``block_height`` (m), the
+    materials, ``fine`` (the requested fine size before rounding, m), ``sizes`` (the rounded
+    sizes and the patches' radii), ``coarse_step_ratio`` (M), and ``record``: the inputs
+    recorded in ``results.json`` and the JSON (plain JSON, the materials as objects of their
+    named fields).
+    """
+
+    regime: str
+    model: str
+    velocity: float
+    radius: float
+    block_radius: float
+    block_height: float
+    ball_material: IsotropicElastic
+    block_material: IsotropicElastic | J2Material
+    fine: float
+    sizes: BallSizes
+    friction: float
+    rigid_wall: bool
+    coarse_step_ratio: int
+    t_end: float | None
+    record: dict[str, Any]
+
+    @property
+    def plastic(self) -> bool:
+        """The plastic regime (the block's patch finite-strain J2)."""
+        return self.regime == "plastic"
+
+    @property
+    def block_size(self) -> float:
+        """The block's smaller dimension (m; infinite against the rigid wall)."""
+        return math.inf if self.rigid_wall else min(self.block_radius, self.block_height)
+
+
 def _axis(x: np.ndarray, tol: float) -> np.ndarray:
     return x[0] < tol
 
@@ -103,7 +151,7 @@ class ImpactBodies:
         ``mono-zoned``: the uniform meshes with J2 only in the block's patch region (the cells
         whose centre lies within ``sizes.block_patch`` of the contact point), elastic elsewhere;
         ``graded``: one conforming mesh per body, the fine size at the contact point growing by
-        :data:`~arlequin.demos.ball_meshes.GROWTH` a cell away from it (the ball's graded
+        :data:`~arlequin.demos.ball_impact.meshes.GROWTH` a cell away from it (the ball's graded
         O-grid), the same laws as ``mono-zoned``.
     sizes : BallSizes
     ball_radius, block_radius, block_height : float

@@ -9,8 +9,10 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..io import JsonResult
-from ..models import IsotropicElastic
+import numpy as np
+
+from ...io import JsonResult
+from ...models import IsotropicElastic
 
 __all__ = [
     "HISTORY_KEYS",
@@ -20,6 +22,7 @@ __all__ = [
     "RESULT_UNITS",
     "BallImpactResult",
     "hertz",
+    "hertz_force_history",
 ]
 
 #: The Interface's keys, in order (then the Hertz values and the inputs).
@@ -62,6 +65,20 @@ def hertz(radius: float, mass: float, velocity: float, ball: IsotropicElastic,
             "hertz_contact_radius": math.sqrt(radius * delta)}  # fmt: skip
 
 
+def hertz_force_history(mass: float, velocity: float, peak: float, duration: float,
+                        n: int = 400) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """Hertz's force against time (s, N): m δ'' = −F, F = k δ^{3/2}, k from the peak force."""
+    from scipy.integrate import solve_ivp
+
+    # k from the peak and the energy: F_max = k δ^{3/2}, ½ m v² = 2/5 k δ^{5/2}
+    d_max = 2.5 * 0.5 * mass * velocity**2 / peak
+    k = peak / d_max**1.5
+    sol = solve_ivp(lambda _t, y: [y[1], -k * max(y[0], 0.0) ** 1.5 / mass], (0.0, duration),
+                    [0.0, velocity], t_eval=np.linspace(0.0, duration, n), rtol=1e-10,
+                    atol=1e-14)  # fmt: skip
+    return sol.t, k * np.maximum(sol.y[0], 0.0) ** 1.5
+
+
 @dataclass
 class BallImpactResult(JsonResult):
     """What a ball-impact run computed (SI units; see the module docstring).
@@ -82,12 +99,12 @@ class BallImpactResult(JsonResult):
         Wall time of the time loop (s).
     history : dict
         Per sample (the first step after each t_end/1000: about 1000 rows,
-        :data:`~arlequin.demos.ball_record.SAMPLES`, or every step of a shorter run): ``t`` (s),
-        ``contact_force``
-        (N), ``ball_velocity`` (m/s, along z), ``kinetic``, ``elastic`` (strain energy of the
-        elastic models and stored energy of the J2 one), ``plastic_dissipation``,
-        ``contact_work`` (of the normal multipliers), ``coupling_work``, ``friction_work`` (of
-        the tangential multipliers, ≤ 0; 0 without friction) (J).
+        :data:`~arlequin.demos.ball_impact.record.SAMPLES`, or every step of a shorter run):
+        ``t`` (s), ``contact_force`` (N), ``ball_velocity`` (m/s, along z), ``kinetic``,
+        ``elastic`` (strain energy of the elastic models and stored energy of the J2 one),
+        ``plastic_dissipation``, ``contact_work`` (of the normal multipliers),
+        ``coupling_work``, ``friction_work`` (of the tangential multipliers, ≤ 0; 0 without
+        friction) (J).
     hertz : dict
         Hertz's values (elastic regime; empty otherwise).
     contact_radius_cells : float
