@@ -11,8 +11,8 @@ from .ball import add_ball_impact
 from .common import add_out as _add_out
 from .common import run_demo
 from .common import write_json as _write_json
+from .generate import add_demo, config_from_args
 from .sliding import add_sliding_block
-from .taylor import add_taylor_bar
 
 __all__ = ["add_demos", "check_case", "demo_parser", "two_bars_options", "wave_options"]
 
@@ -22,15 +22,16 @@ def add_demos(sub) -> None:
     _add_patch_test(sub)
     _add_two_bars(sub)
     _add_wave(sub)
-    add_taylor_bar(sub)
+    _add_generated(sub, _taylor_bar_config())
     add_sliding_block(sub)
     add_ball_impact(sub)
 
 
 def check_case(demo: str, args: argparse.Namespace) -> None:
-    """The demo's own input checks on a parsed command line, nothing run or written (its run
-    function with ``check_only=True``; the patch test's options are all choices and integers,
-    which the parser has checked). Raises the demo's ``ValueError``."""
+    """The demo's own input checks on a parsed command line, nothing run or written (its
+    configuration made from the options, or its run function with ``check_only=True``; the
+    patch test's options are all choices and integers, which the parser has checked). Raises
+    the demo's ``ValueError``."""
     if demo == "two-bars":
         from ..demos.two_bars import run_two_bars
 
@@ -40,10 +41,7 @@ def check_case(demo: str, args: argparse.Namespace) -> None:
 
         run_wave(**wave_options(args), check_only=True)
     elif demo == "taylor-bar":
-        from ..demos.taylor_bar import run_taylor_bar
-        from .taylor import run_options
-
-        run_taylor_bar(**run_options(args), check_only=True)
+        config_from_args(_taylor_bar_config(), args)
     elif demo == "sliding-block":
         from ..demos.sliding_block import run_sliding_block
         from .sliding import sliding_options
@@ -54,6 +52,24 @@ def check_case(demo: str, args: argparse.Namespace) -> None:
         from .ball import ball_options
 
         run_ball_impact(**ball_options(args), check_only=True)
+
+
+def _taylor_bar_config():
+    from ..demos.taylor_bar import TaylorBarConfig
+
+    return TaylorBarConfig
+
+
+def _add_generated(sub, config) -> argparse.ArgumentParser:
+    """A demo's subcommand generated from its configuration (:func:`add_demo`). The options
+    whose field says ``parse=str`` take the word as text: the generator would parse a ``None``
+    default as a number, and the record of the options has them untyped."""
+    p = add_demo(sub, config)
+    text = {f.name for f, opt in config.fields() if opt.cli and opt.parse is str}
+    for action in p._actions:
+        if action.dest in text:
+            action.type = None
+    return p
 
 
 def demo_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.ArgumentParser]]:

@@ -58,7 +58,7 @@ from ..solvers import solve
 from .ball_record import ImpactRecorder, write_outputs
 from .ball_result import INPUT_UNITS, JSON_KEYS, BallImpactResult, hertz
 from .ball_setup import ImpactBodies, ball_sizes
-from .taylor_result import GluingBandPlasticityWarning
+from .taylor_bar.result import GluingBandPlasticityWarning
 
 __all__ = ["JSON_KEYS", "MODELS", "REGIMES", "BallImpactResult", "hertz", "run_ball_impact"]
 
