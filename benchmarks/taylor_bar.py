@@ -26,7 +26,7 @@ of them in ``wall_times_s``).
 ``--geometry 3d``: the quarter bar of hexahedra. There the uniform reference of ``--compare`` is
 the single mesh with the patch's nodes (``--model mono --coarse-size``: the coarse O-grid
 refined), and the graded mesh has three sheets of 2:1 transition templates
-(:mod:`arlequin.demos.taylor_graded_3d`).
+(:mod:`arlequin.demos.taylor_bar.graded_3d`).
 
 With ``--coarse-step-ratio M`` the Arlequin bar is also run with the multi-time-step scheme
 (the coarse model's force every m ≤ M fine steps): its wall time, the gain over the one-step

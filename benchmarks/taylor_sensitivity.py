@@ -38,7 +38,7 @@ def main(argv: list[str] | None = None) -> int:
                         help="indices of CASES to run (default all)")  # fmt: skip
     args = parser.parse_args(argv)
     from arlequin.demos.taylor_bar import GluingBandPlasticityWarning, run_taylor_bar
-    from arlequin.demos.taylor_meshes import arlequin_bar_sizes
+    from arlequin.demos.taylor_bar.meshes import arlequin_bar_sizes
     from arlequin.models.plasticity.j2_kernel import warm_up
 
     warm_up()

@@ -19,7 +19,7 @@ import trimesh
 
 import arlequin
 from arlequin.coupling.patches import select_cells
-from arlequin.demos.taylor_meshes_3d import quarter_bar_mesh, refined_bar_mesh
+from arlequin.demos.taylor_bar.meshes_3d import quarter_bar_mesh, refined_bar_mesh
 from arlequin.models import (
     ContactSurface,
     FiniteStrainJ2,

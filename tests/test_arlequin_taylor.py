@@ -1,4 +1,4 @@
-"""The Arlequin Taylor bar (arlequin/demos/taylor_models.py, ``--model arlequin``).
+"""The Arlequin Taylor bar (arlequin/demos/taylor_bar/models.py, ``--model arlequin``).
 
 Reference values come from:
 * exact facts of the set-up: the nested sizes follow from L = 32.4 mm, R = 3.2 mm by rounding
@@ -29,8 +29,8 @@ from arlequin.demos.taylor_bar import (
     GluingBandPlasticityWarning,
     run_taylor_bar,
 )
-from arlequin.demos.taylor_meshes import arlequin_bar_sizes
-from arlequin.demos.taylor_models import ArlequinBar
+from arlequin.demos.taylor_bar.meshes import arlequin_bar_sizes
+from arlequin.demos.taylor_bar.models import ArlequinBar
 from arlequin.io import read_series
 from arlequin.models import J2Material, make_hardening
 
@@ -194,7 +194,7 @@ def test_arlequin_matches_the_single_mesh_run():
 def test_graded_mesh_is_conforming_and_covers_the_bar(fine):
     import skfem
 
-    from arlequin.demos.taylor_meshes import graded_bar_mesh
+    from arlequin.demos.taylor_bar.meshes import graded_bar_mesh
     from arlequin.geometry.meshcheck import check_mesh
 
     s = arlequin_bar_sizes(L, R, fine)
@@ -215,7 +215,7 @@ def test_graded_mesh_is_conforming_and_covers_the_bar(fine):
 
 
 def test_graded_mesh_needs_a_ratio_of_two():
-    from arlequin.demos.taylor_meshes import graded_bar_mesh
+    from arlequin.demos.taylor_bar.meshes import graded_bar_mesh
 
     with pytest.raises(ValueError, match="ratio 2"):
         graded_bar_mesh(L, R, arlequin_bar_sizes(L, R, 12, coarse_size=R / 3))

@@ -1,4 +1,4 @@
-"""The 3D Taylor bar (arlequin/demos/taylor_models_3d.py, taylor_meshes_3d.py): the quarter bar
+"""The 3D Taylor bar (arlequin/demos/taylor_bar/models_3d.py, meshes_3d.py): the quarter bar
 of F-bar hexahedra, one mesh or the Arlequin pair, and its product.
 
 Reference values come from:
@@ -26,7 +26,7 @@ import skfem
 
 from arlequin.cli.main import main
 from arlequin.demos.taylor_bar import JSON_KEYS, TAYLOR_REFERENCE, run_taylor_bar
-from arlequin.demos.taylor_meshes_3d import (
+from arlequin.demos.taylor_bar.meshes_3d import (
     lateral_nodes,
     quarter_bar_mesh,
     quarter_section_counts,
@@ -80,8 +80,8 @@ def test_refined_mesh_is_nested_up_to_the_sagitta():
 def test_graded_mesh_is_conforming_and_has_the_patch_and_coarse_nodes(n):
     from scipy.spatial import cKDTree
 
-    from arlequin.demos.taylor_graded_3d import graded_bar_mesh_3d
-    from arlequin.demos.taylor_meshes import arlequin_bar_sizes
+    from arlequin.demos.taylor_bar.graded_3d import graded_bar_mesh_3d
+    from arlequin.demos.taylor_bar.meshes import arlequin_bar_sizes
 
     s = arlequin_bar_sizes(L, R, n, None, None, None)
     mesh = graded_bar_mesh_3d(L, R, s)

@@ -1,4 +1,4 @@
-"""The Taylor bar demo (arlequin/demos/taylor_bar.py): the product, and the physics against the
+"""The Taylor bar demo (arlequin/demos/taylor_bar/): the product, and the physics against the
 published values.
 
 Reference values come from:

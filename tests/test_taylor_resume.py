@@ -1,5 +1,5 @@
 """Interrupted Taylor bar runs resume from their checkpoints to the uninterrupted run's values,
-bit for bit (arlequin/demos/taylor_checkpoint.py).
+bit for bit (arlequin/demos/taylor_bar/checkpoint.py).
 
 The reference is the same run, uninterrupted, in the same process: everything computed must be
 equal (the exact values, not within a tolerance); wall times and timestamps are excluded.

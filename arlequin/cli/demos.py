@@ -1,7 +1,7 @@
 """The demos' subcommands, registered in one place (:func:`add_demos`), shared by ``arlequin``
 and the study runner (:mod:`arlequin.demos.study`), which parses and runs a case exactly as
-the command line would. Every subcommand but taylor-bar is generated from its demo's
-configuration (:mod:`arlequin.cli.generate`)."""
+the command line would. Every subcommand is generated from its demo's configuration
+(:mod:`arlequin.cli.generate`)."""
 
 from __future__ import annotations
 
@@ -12,10 +12,10 @@ from ..demos.patch_test.config import PatchTestConfig
 from ..demos.plate_with_hole.config import PlateWithHoleConfig
 from ..demos.pressure_vessel.config import PressureVesselConfig
 from ..demos.sliding_block.config import SlidingBlockConfig
+from ..demos.taylor_bar.config import TaylorBarConfig
 from ..demos.two_bars.config import TwoBarsConfig
 from ..demos.wave.config import WaveConfig
 from .generate import add_demo, config_from_args
-from .taylor import add_taylor_bar
 
 __all__ = ["add_demos", "check_case", "demo_parser"]
 
@@ -25,7 +25,7 @@ def add_demos(sub) -> None:
     add_demo(sub, PatchTestConfig)
     add_demo(sub, TwoBarsConfig)
     add_demo(sub, WaveConfig)
-    add_taylor_bar(sub)
+    add_demo(sub, TaylorBarConfig)
     add_demo(sub, SlidingBlockConfig)
     add_demo(sub, BallImpactConfig)
     add_demo(sub, PressureVesselConfig)
@@ -33,17 +33,13 @@ def add_demos(sub) -> None:
 
 
 def check_case(demo: str, args: argparse.Namespace) -> None:
-    """The demo's own input checks on a parsed command line, nothing run or written (a
-    generated subcommand's configuration made from the options; the other demos' run function
-    with ``check_only=True``). Raises the demo's ``ValueError``."""
+    """The demo's own input checks on a parsed command line, nothing run or written: its
+    configuration made from the options (its checks run then). Raises the demo's
+    ``ValueError``."""
     config = getattr(args, "config", None)
-    if config is not None:  # a generated subcommand: its configuration checks the values
-        config_from_args(config, args)
-    elif demo == "taylor-bar":
-        from ..demos.taylor_bar import run_taylor_bar
-        from .taylor import run_options
-
-        run_taylor_bar(**run_options(args), check_only=True)
+    if config is None:
+        raise ValueError(f"{demo!r} is not a demo of the arlequin command")
+    config_from_args(config, args)
 
 
 def demo_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.ArgumentParser]]:

@@ -23,6 +23,8 @@ __all__ = ["add_demo", "config_from_args", "parse_type", "run_command"]
 
 def parse_type(field: dataclasses.Field, opt: Option) -> Callable[[str], Any] | None:
     """The converter of one command-line word for ``field`` (None: a string)."""
+    if opt.parse is str:  # text: argparse's own (untyped) word
+        return None
     if opt.parse is not None:
         return opt.parse
     default = field.default

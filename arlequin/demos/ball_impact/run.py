@@ -21,7 +21,7 @@ import numpy as np
 
 from ...io import DynamicRunWriter, ResultsFolder
 from ...solvers import solve
-from ..taylor_result import GluingBandPlasticityWarning
+from ..taylor_bar.result import GluingBandPlasticityWarning
 from .record import ImpactRecorder
 from .report import write_outputs
 from .result import BallImpactResult, hertz

@@ -8,14 +8,16 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..io import JsonResult
-from ..io.folder import jsonable
+from ...io import JsonResult
+from ...io.folder import jsonable
 
 __all__ = [
     "ARLEQUIN_JSON_KEYS",
+    "DERIVED_INPUT_UNITS",
     "GEOMETRIES",
     "JSON_KEYS",
     "MODELS",
+    "RESULT_UNITS",
     "TAYLOR_REFERENCE",
     "GluingBandPlasticityWarning",
     "TaylorBarResult",
@@ -43,6 +45,28 @@ MODELS = ("arlequin", "mono", "graded")
 
 #: The bar's geometries: the (r, z) section, or the quarter bar of hexahedra.
 GEOMETRIES = ("axisymmetric", "3d")
+
+
+#: Units of the recorded inputs that are not parameters of the configuration (resolved counts
+#: and sizes; the parameters' units come from the configuration's fields).
+DERIVED_INPUT_UNITS = {
+    "elements_axial": "1", "mesh_size": "m", "coarse_radial": "1", "coarse_axial": "1",
+    "ratio": "1", "patch_rows": "1", "band_rows": "1", "epsilon": "1",
+    "bulk_viscosity_linear": "1", "bulk_viscosity_quadratic": "1",
+}  # fmt: skip
+
+#: Units of the results written to results.json.
+RESULT_UNITS = {
+    "final_length": "m", "mushroom_radius": "m", "max_plastic_strain": "1",
+    "energy_balance_error": "1", "n_elements": "1", "mesh_size": "m", "n_steps": "1",
+    "wall_time_s": "s", "initial_kinetic_energy": "J", "impact_loss": "J", "min_dt": "s",
+    "max_plastic_strain_at": "m", "final_energies": "J", "qp_updates_per_second": "1/s",
+    "setup_time_s": "s", "elements_radial": "1", "elements_axial": "1",
+    "coarse_elements": "1", "fine_elements": "1", "coarse_size": "m",
+    "fine_size": "m", "patch_fraction": "1", "patch_length": "m", "gluing_width": "m",
+    "band_max_plastic_strain": "1", "multiplier_chatter": "1",
+    "multiplier_chatter_per_row": "1",
+}  # fmt: skip
 
 
 class GluingBandPlasticityWarning(UserWarning):
@@ -117,7 +141,7 @@ class TaylorBarResult(JsonResult):
         rows whose peak exceeds 1% of the largest).
     model, u, state, setup : the finite-strain model, the final displacement of the whole
         system (m), the finite-strain model's final quadrature state and the set-up
-        (:class:`~arlequin.demos.taylor_models.MonoBar` or ``ArlequinBar``), not in the JSON.
+        (:class:`~arlequin.demos.taylor_bar.models.MonoBar` or ``ArlequinBar``), not in the JSON.
     multiplier_history : MultiplierHistory or None
         ``arlequin``: the per-step mediator multipliers (not in the JSON).
     """

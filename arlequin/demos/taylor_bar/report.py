@@ -1,15 +1,48 @@
-"""Pictures of the demos (matplotlib, PNG): time histories and snapshots against references."""
+"""The Taylor bar's report: the results written at the end of a run (scalars with their units,
+the final results.json) and its pictures (the history plot; the final shape, drawn by the bar's
+own ``render``: :mod:`~arlequin.demos.taylor_bar.render`, :mod:`~arlequin.demos.taylor_bar.
+render_3d`). SI units.
+"""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-if TYPE_CHECKING:
-    from .taylor_bar import TaylorBarResult
+from ...io import ResultsFolder
 
-__all__ = ["plot_taylor_bar"]
+if TYPE_CHECKING:
+    from .result import TaylorBarResult
+
+__all__ = ["plot_taylor_bar", "write_results"]
+
+
+def write_results(folder: ResultsFolder, result: Any, units: dict[str, str]) -> None:
+    """The scalar results (with ``units``), the pictures and the final results.json."""
+    values = {k: v for k, v in result.to_json().items()
+              if k not in ("history", "config", "reference")}  # fmt: skip
+    hist = result.history
+    values["final_energies"] = {
+        k: hist[k][-1]
+        for k in (
+            "kinetic",
+            "elastic",
+            "plastic_dissipation",
+            "viscous_dissipation",
+            "coupling_work",
+            "contact_work",
+        )
+        if k in hist
+    }
+    folder.add_results(values, units)
+    plot_taylor_bar(result, str(folder.picture("taylor_bar_history")))
+    title = (f"t = {result.history['t'][-1] * 1e6:.1f} us: length {result.final_length * 1e3:.2f} "
+             f"mm, footprint radius {result.mushroom_radius * 1e3:.2f} mm"
+             + ("" if result.arlequin or result.config.get("geometry") == "3d"
+                else " (grey: initial shape)"))  # fmt: skip
+    result.setup.render(result.u, result.state, str(folder.picture("taylor_bar")), title)
+    folder.finish()
 
 
 def plot_taylor_bar(result: TaylorBarResult, path: str) -> None:

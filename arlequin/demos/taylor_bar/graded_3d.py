@@ -1,10 +1,10 @@
 """The graded 3D Taylor bar: one conforming hexahedral mesh, fine over the patch region, coarse
 above, with three sheets of 2:1 transition templates.
 
-The 2D template of :func:`~arlequin.demos.taylor_meshes.graded_bar_mesh` (four fine edges below,
+The 2D template of :func:`~arlequin.demos.taylor_bar.meshes.graded_bar_mesh` (four fine edges below,
 two coarse edges above, six quadrilaterals) halves one direction; extruded along the other
 in-plane direction it is a sheet of hexahedra that halves that direction of a structured block.
-Each block of the O-grid section (:mod:`arlequin.demos.taylor_meshes_3d`) has two directions to
+Each block of the O-grid section (:mod:`arlequin.demos.taylor_bar.meshes_3d`) has two directions to
 halve, and the three blocks meet along interfaces that must be halved in the same sheet on both
 sides: with two sheets the cycle inner block – outer block – outer block cannot be consistent,
 with three it is:
@@ -20,7 +20,7 @@ sheet      inner block      outer block (x)     outer block (y)
 (a block passes a sheet through, unchanged, when it halves nothing in it). Each sheet is one
 coarse layer tall, so the transition takes three coarse layers above the patch. All nodes are
 the coarse O-grid's cells refined (their trilinear midpoints, the lateral ones moved radially
-onto the cylinder as :func:`~arlequin.demos.taylor_meshes_3d.refined_bar_mesh` does): the fine
+onto the cylinder as :func:`~arlequin.demos.taylor_bar.meshes_3d.refined_bar_mesh` does): the fine
 region is the Arlequin patch's mesh node for node, the coarse region the coarse model's. The
 blocks' coarse counts must be even (the templates pair coarse cells). SI units.
 """
@@ -30,10 +30,14 @@ from __future__ import annotations
 import numpy as np
 import skfem
 
-from .taylor_meshes import ArlequinBarSizes
-from .taylor_meshes_3d import quarter_section_counts, section_blocks
+from .meshes import ArlequinBarSizes
+from .meshes_3d import quarter_section_counts, section_blocks
 
-__all__ = ["TRANSITION_LAYERS", "graded_bar_mesh_3d"]
+__all__ = [
+    "TRANSITION_LAYERS",
+    "check_graded_sizes",
+    "graded_bar_mesh_3d",
+]
 
 #: Coarse layers the three transition sheets take above the patch.
 TRANSITION_LAYERS = 3
@@ -82,9 +86,8 @@ def _cells(block: int, counts, steps, sheet: int, z0: float, height: float):
     return np.stack(cells), steps
 
 
-def graded_bar_mesh_3d(length: float, radius: float, sizes: ArlequinBarSizes) -> skfem.MeshHex:
-    """One conforming mesh of the quarter bar: fine below ``patch_length``, three transition
-    sheets, the coarse O-grid above (module docstring).
+def check_graded_sizes(sizes: ArlequinBarSizes) -> tuple[int, int]:
+    """The O-grid's block counts (n_s, n_o) of the 3D graded mesh's coarse section.
 
     Raises
     ------
@@ -106,6 +109,22 @@ def graded_bar_mesh_3d(length: float, radius: float, sizes: ArlequinBarSizes) ->
     if above < TRANSITION_LAYERS:
         raise ValueError(f"the 3D graded mesh needs {TRANSITION_LAYERS} coarse layers above the "
                          f"patch for its transition, the patch leaves {above}")  # fmt: skip
+    return n_s, n_o
+
+
+def graded_bar_mesh_3d(length: float, radius: float, sizes: ArlequinBarSizes) -> skfem.MeshHex:
+    """One conforming mesh of the quarter bar: fine below ``patch_length``, three transition
+    sheets, the coarse O-grid above (module docstring).
+
+    Raises
+    ------
+    ValueError
+        Unless the coarse size is twice the fine size, the blocks' coarse counts are even, and
+        the patch leaves at least the three transition layers above it.
+    """
+    s = sizes
+    n_s, n_o = check_graded_sizes(s)
+    above = s.coarse_axial - s.patch_rows
     hz = s.axial_size
     z_layers = [(0, 0.5 * hz * k, 0.5 * hz) for k in range(2 * s.patch_rows)]  # fine
     z_p = s.patch_length

@@ -11,8 +11,8 @@ from typing import Any
 
 import numpy as np
 
-from ..io import meshio_mesh
-from .render import _offscreen
+from ...io import meshio_mesh
+from ..render import _offscreen
 
 __all__ = ["render_taylor_bar_3d"]
 
@@ -36,7 +36,7 @@ def _full_bar(pv, mesh, displacement: np.ndarray, cells: np.ndarray, values=None
 
 
 def render_taylor_bar_3d(bar: Any, u: np.ndarray, state: Any, path: str, title: str = "") -> None:
-    """The final state of a 3D Taylor bar (:mod:`arlequin.demos.taylor_models_3d`) as a PNG.
+    """The final state of a 3D Taylor bar (:mod:`arlequin.demos.taylor_bar.models_3d`) as a PNG.
 
     ``bar`` is a ``MonoBar3D`` (one mesh coloured by ε̄p) or an ``ArlequinBar3D`` (the coarse
     model translucent, the patch coloured by ε̄p); ``u`` the system's displacement (m).

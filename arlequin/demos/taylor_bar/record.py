@@ -3,8 +3,8 @@
 :class:`TaylorRecorder` listens to the integrator (``on_record``) and, at every record, appends
 a row of the history (length, footprint radius, energies, the wall's force and work, the step)
 to memory and to ``history.csv``, checks the energy balance and writes the field frames
-(fields/bar.xdmf) at the frame times; :func:`write_results` writes the scalar results and the
-pictures at the end. SI units.
+(fields/bar.xdmf) at the frame times (:func:`~arlequin.demos.taylor_bar.report.write_results`
+writes the scalar results and the pictures at the end). SI units.
 """
 
 from __future__ import annotations
@@ -14,9 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from ..io import ResultsFolder
-
-__all__ = ["HISTORY_UNITS", "MultiplierHistory", "TaylorRecorder", "write_results"]
+__all__ = ["HISTORY_UNITS", "MultiplierHistory", "TaylorRecorder"]
 
 #: History columns and their units.
 HISTORY_UNITS = {
@@ -40,7 +38,7 @@ class TaylorRecorder:
     Parameters
     ----------
     bar : MonoBar or ArlequinBar
-        The view of the models (:mod:`arlequin.demos.taylor_models`): ``measures(u)``,
+        The view of the models (:mod:`arlequin.demos.taylor_bar.models`): ``measures(u)``,
         ``energies(integ, integ.energies())``, ``series_meshes()``, ``frame(integ)``.
     con_name : str
         The wall constraint's name.
@@ -220,32 +218,3 @@ class MultiplierHistory:
             return {"global": 0.0, "per_row": 0.0}
         big = peak > 0.01 * top
         return {"global": float(osc.max() / top), "per_row": float((osc[big] / peak[big]).max())}
-
-
-def write_results(folder: ResultsFolder, result: Any, units: dict[str, str]) -> None:
-    """The scalar results (with ``units``), the pictures and the final results.json."""
-    from .plots import plot_taylor_bar
-
-    values = {k: v for k, v in result.to_json().items()
-              if k not in ("history", "config", "reference")}  # fmt: skip
-    hist = result.history
-    values["final_energies"] = {
-        k: hist[k][-1]
-        for k in (
-            "kinetic",
-            "elastic",
-            "plastic_dissipation",
-            "viscous_dissipation",
-            "coupling_work",
-            "contact_work",
-        )
-        if k in hist
-    }
-    folder.add_results(values, units)
-    plot_taylor_bar(result, str(folder.picture("taylor_bar_history")))
-    title = (f"t = {result.history['t'][-1] * 1e6:.1f} us: length {result.final_length * 1e3:.2f} "
-             f"mm, footprint radius {result.mushroom_radius * 1e3:.2f} mm"
-             + ("" if result.arlequin or result.config.get("geometry") == "3d"
-                else " (grey: initial shape)"))  # fmt: skip
-    result.setup.render(result.u, result.state, str(folder.picture("taylor_bar")), title)
-    folder.finish()

@@ -18,7 +18,7 @@ import pickle
 from pathlib import Path
 from typing import Any
 
-from ..io import read_series
+from ...io import read_series
 
 __all__ = ["CHECKPOINT", "CheckpointWriter", "load_checkpoint", "read_frames"]
 

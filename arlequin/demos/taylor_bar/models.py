@@ -21,7 +21,7 @@ every patch dof of the band to the coarse field, the rows of u_r on the axis wou
 axis conditions (linearly dependent rows), and with either mediator they would carry the axis
 reactions, which oscillate from step to step in an explicit run.
 
-Both classes give the recorder (:mod:`arlequin.demos.taylor_record`) the same view: the
+Both classes give the recorder (:mod:`arlequin.demos.taylor_bar.record`) the same view: the
 length and footprint radius of a displacement, the energies of the models, the field frames
 and the final picture. SI units.
 """
@@ -34,7 +34,7 @@ import numpy as np
 import scipy.sparse as sp
 import skfem
 
-from ..models import (
+from ...models import (
     HARDENING_LAWS,
     ContactSurface,
     CoulombContact,
@@ -46,9 +46,9 @@ from ..models import (
     RigidContactPair,
     make_hardening,
 )
-from ..problem.arlequin_problem import ArlequinProblem, Patch
-from ..problem.system import Block, BlockTerm, CoupledSystem, LinearConstraint
-from .taylor_meshes import ArlequinBarSizes, taylor_bar_mesh
+from ...problem.arlequin_problem import ArlequinProblem, Patch
+from ...problem.system import Block, BlockTerm, CoupledSystem, LinearConstraint
+from .meshes import ArlequinBarSizes, taylor_bar_mesh
 
 __all__ = ["LAW_DEFAULTS", "ArlequinBar", "ArlequinBarView", "MonoBar", "hardening_parameters"]
 

@@ -1,12 +1,12 @@
 """The 3D Taylor bar: a quarter bar of hexahedra, one finite-strain mesh or the Arlequin pair.
 
-The quarter x, y ≥ 0 of the bar (:mod:`arlequin.demos.taylor_meshes_3d`) with the symmetry
+The quarter x, y ≥ 0 of the bar (:mod:`arlequin.demos.taylor_bar.meshes_3d`) with the symmetry
 conditions u_x = 0 on x = 0 and u_y = 0 on y = 0. :class:`MonoBar3D` is one finite-strain J2
 mesh of 8-node F-bar hexahedra over the whole quarter; :class:`ArlequinBar3D` a coarse
 linear-elastic quarter bar plus a nested finite-strain patch over the impacted end (the coarse
 cells below ``patch_length`` refined, their new lateral nodes moved onto the cylinder), glued by
 the mediator in a band of coarse layers at the patch's top, as the axisymmetric
-:class:`~arlequin.demos.taylor_models.ArlequinBar` (same weights, weight floor, mediator space
+:class:`~arlequin.demos.taylor_bar.models.ArlequinBar` (same weights, weight floor, mediator space
 without the symmetry components). The wall z = 0 is the level-set contact on the impact face and
 the lower lateral surface.
 
@@ -23,8 +23,8 @@ import numpy as np
 import scipy.sparse as sp
 import skfem
 
-from ..coupling.patches import Patch, select_cells
-from ..models import (
+from ...coupling.patches import Patch, select_cells
+from ...models import (
     ContactSurface,
     CoulombContact,
     FiniteStrainJ2,
@@ -34,13 +34,17 @@ from ..models import (
     PlaneObstacle,
     RigidContactPair,
 )
-from ..problem.arlequin_problem import ArlequinProblem
-from ..problem.system import Block, BlockTerm, CoupledSystem, LinearConstraint
-from .taylor_meshes import ArlequinBarSizes
-from .taylor_meshes_3d import patch_levels, quarter_bar_mesh, refined_bar_mesh
-from .taylor_models import LATERAL_CONTACT, ArlequinBarView
+from ...problem.arlequin_problem import ArlequinProblem
+from ...problem.system import Block, BlockTerm, CoupledSystem, LinearConstraint
+from .meshes import ArlequinBarSizes
+from .meshes_3d import patch_levels, quarter_bar_mesh, refined_bar_mesh
+from .models import LATERAL_CONTACT, ArlequinBarView
 
-__all__ = ["ArlequinBar3D", "MonoBar3D"]
+__all__ = [
+    "ArlequinBar3D",
+    "MonoBar3D",
+    "check_arlequin_sizes_3d",
+]
 
 
 def _wall(mesh, offset, dofmap, material, radius, lateral, friction) -> LevelSetContact:
@@ -198,6 +202,25 @@ class MonoBar3D(_Quarter):
         return {"bar": (point, cell)}
 
 
+def check_arlequin_sizes_3d(s: ArlequinBarSizes) -> int:
+    """The refinement levels of the 3D Arlequin bar's patch (2^levels = s.ratio).
+
+    Raises
+    ------
+    ValueError
+        Unless the ratio is a power of two and the coarse O-grid has at least 4 cells across
+        the radius.
+    """
+    levels = patch_levels(s.ratio)
+    if s.coarse_radial < 4:
+        # coarser, the O-grid's chords lie too far inside the cylinder for the patch's
+        # lateral nodes (on it) to be located in the coarse cells
+        raise ValueError(f"the 3D Arlequin bar needs at least 4 coarse cells across the "
+                         f"radius, got {s.coarse_radial} (coarse size "
+                         f"{s.coarse_size:.4g} m): refine the coarse size")  # fmt: skip
+    return levels
+
+
 class ArlequinBar3D(ArlequinBarView, _Quarter):
     """The coarse linear-elastic quarter bar plus the nested finite-strain J2 patch.
 
@@ -213,7 +236,7 @@ class ArlequinBar3D(ArlequinBarView, _Quarter):
         ``ratio`` a power of two (fine cells per coarse edge), ``patch_rows`` and ``band_rows``
         coarse layers.
     material, weights, mediator, coupling, epsilon, fbar, backend, bulk_viscosity, friction
-        As :class:`~arlequin.demos.taylor_models.ArlequinBar`.
+        As :class:`~arlequin.demos.taylor_bar.models.ArlequinBar`.
     """
 
     fine_block = "patch"
@@ -224,13 +247,7 @@ class ArlequinBar3D(ArlequinBarView, _Quarter):
                  backend="auto", bulk_viscosity=None, friction: float = 0.0,
                  surface: Any = None) -> None:  # fmt: skip
         s = sizes
-        levels = patch_levels(s.ratio)
-        if s.coarse_radial < 4:
-            # coarser, the O-grid's chords lie too far inside the cylinder for the patch's
-            # lateral nodes (on it) to be located in the coarse cells
-            raise ValueError(f"the 3D Arlequin bar needs at least 4 coarse cells across the "
-                             f"radius, got {s.coarse_radial} (coarse size "
-                             f"{s.coarse_size:.4g} m): refine the coarse size")  # fmt: skip
+        levels = check_arlequin_sizes_3d(s)
         self.sizes, self.radius = s, radius
         cmesh = quarter_bar_mesh(length, radius, s.coarse_radial, s.coarse_axial)
         if surface is None:
