@@ -6,15 +6,17 @@ from __future__ import annotations
 import logging
 import time
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ...io import QuasiStaticRunWriter, ResultsFolder
 from ...solvers import NewtonError, QuasiStaticSolver
-from .config import PlateWithHoleConfig
 from .result import HISTORY_KEYS, UNITS, PlateWithHoleResult
 from .setup import PlateSetup, build, loaded_edge_average
+
+if TYPE_CHECKING:  # annotations only: the configuration runs this module
+    from .config import PlateWithHoleConfig
 
 __all__ = ["plastic_measures", "run"]
 

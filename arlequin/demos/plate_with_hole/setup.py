@@ -21,7 +21,7 @@ from __future__ import annotations
 import logging
 import warnings
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import scipy.sparse as sp
@@ -32,8 +32,10 @@ from ...coupling.gluing import Patch
 from ...models import IsotropicElastic, J2Material, LinearElastic
 from ...problem.arlequin_problem import ArlequinProblem
 from ...problem.system import Block, BlockTerm, CoupledSystem
-from .config import PlateWithHoleConfig
 from .meshes import graded_plate_mesh, quarter_plate_mesh, refine_projected
+
+if TYPE_CHECKING:  # annotations only: the configuration runs this module
+    from .config import PlateWithHoleConfig
 
 __all__ = [
     "DENSITY",

@@ -10,7 +10,8 @@ from typing import Any
 import numpy as np
 
 from ...io import ResultsFolder
-from . import hill
+from .hill import cylinder_limit_load, sphere_limit_load, sphere_outer_displacement
+from .measures import von_mises
 from .result import PressureVesselResult
 from .setup import VesselSetup
 
@@ -19,7 +20,6 @@ __all__ = ["cell_fields", "plot_plastic_zone", "plot_pressure_curve", "write_pic
 
 def cell_fields(setup: VesselSetup) -> Callable[[Any], dict[str, dict[str, np.ndarray]]]:
     """The cell data of a frame: the J2 model's ε̄p and von Mises stress, cell means."""
-    from .run import von_mises
 
     def fields(solver: Any) -> dict[str, dict[str, np.ndarray]]:
         state = solver.states[setup.plastic_block][0]
@@ -47,12 +47,12 @@ def plot_pressure_curve(result: PressureVesselResult, config: dict, path: str) -
             label=f"{config['model']} ({config['material']})")  # fmt: skip
     a, b, sy = config["inner"], config["outer"], config["yield_stress"]
     if config["shape"] == "sphere":
-        p = np.linspace(0.0, 0.999 * hill.sphere_limit_load(a, b, sy), 200)
-        u = [hill.sphere_outer_displacement(x, a, b, config["young"], config["poisson"], sy)
+        p = np.linspace(0.0, 0.999 * sphere_limit_load(a, b, sy), 200)
+        u = [sphere_outer_displacement(x, a, b, config["young"], config["poisson"], sy)
              for x in p]  # fmt: skip
         ax.plot(np.array(u) * 1e6, p / 1e6, "k--", label="Hill (exact)")
     else:
-        ax.axhline(hill.cylinder_limit_load(a, b, sy) / 1e6, color="k", ls="--",
+        ax.axhline(cylinder_limit_load(a, b, sy) / 1e6, color="k", ls="--",
                    label="limit load (2/√3) σy ln(b/a)")  # fmt: skip
     ax.set_xlabel("outer radial displacement (µm)")
     ax.set_ylabel("bore pressure (MPa)")

@@ -13,7 +13,7 @@ from __future__ import annotations
 import logging
 import warnings
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -21,8 +21,10 @@ from ...coupling.exactness import ExactnessWarning
 from ...coupling.gluing import Patch
 from ...models import FiniteStrainJ2, IsotropicElastic, J2Material, LinearElastic
 from ...problem.arlequin_problem import ArlequinProblem
-from .config import PressureVesselConfig
 from .meshes import VesselMeshes, vessel_meshes
+
+if TYPE_CHECKING:  # annotations only: the configuration runs this module
+    from .config import PressureVesselConfig
 
 __all__ = ["DENSITY", "VesselSetup", "build"]
 

@@ -4,7 +4,7 @@
 :mod:`.config` (:class:`SlidingBlockConfig`, the parameters), :mod:`.setup` (mesh, model,
 loading, contact, exact solution), :mod:`.run` (the run as named steps), :mod:`.result`
 (:class:`SlidingBlockResult`), :mod:`.report` (the results folder and the picture),
-:mod:`.entry` (:func:`run_sliding_block`).
+:mod:`.api` (:func:`run_sliding_block`).
 
 A block of height H (the last axis is vertical, the plane is z = 0 in 3D, y = 0 in 2D plane
 strain) lies on a rigid plane; the level-set contact with Coulomb friction μ
@@ -54,7 +54,7 @@ fields/block.xdmf, sliding_block.png. SI units.
 """
 
 from .config import DAMPING, DEFAULT_PRESSURE, RAMP_TRANSITS, SlidingBlockConfig
-from .entry import run_sliding_block
+from .api import run_sliding_block
 from .report import plot_sliding_block
 from .result import JSON_KEYS, RESULT_UNITS, SlidingBlockResult
 from .run import SAFETY, STOP_FRACTION
