@@ -53,8 +53,8 @@ record), sliding.csv (per step: mean velocity, slip velocity, works, fixed-point
 fields/block.xdmf, sliding_block.png. SI units.
 """
 
-from .config import DAMPING, DEFAULT_PRESSURE, RAMP_TRANSITS, SlidingBlockConfig
 from .api import run_sliding_block
+from .config import DAMPING, DEFAULT_PRESSURE, RAMP_TRANSITS, SlidingBlockConfig
 from .report import plot_sliding_block
 from .result import JSON_KEYS, RESULT_UNITS, SlidingBlockResult
 from .run import SAFETY, STOP_FRACTION
