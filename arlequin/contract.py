@@ -144,6 +144,15 @@ class DynamicModel(Protocol):
     the first ``internal_force`` call gets ``state=None``) and ``uses_time_step`` (default
     False): when True, the integrators call ``internal_force(u, state, weight, dt=h)`` with h
     (s) the step that leads to u (None at the initial time), for rate-dependent state updates.
+
+    Energy members (optional, looked up with ``getattr``; both or neither):
+    ``stored_energy_of_state(state, weight) -> float``, the stored (recoverable) energy of a
+    committed state (J), and ``plastic_dissipation(state, weight) -> float``, the plastic
+    dissipation accumulated up to it (J), both weighted by α like the forces. With them the
+    integrators report a nonlinear block's ``stored`` energy and ``dissipation``
+    (``Integrator.energies``, ``DynamicResult.material_balance``); without them its stored
+    energy is the accumulated work of its internal forces. A model whose state does not
+    determine them may raise ``ValueError`` (the block then falls back likewise).
     """
 
     n_dofs: int

@@ -462,22 +462,32 @@ class Integrator:
         Returns
         -------
         dict
-            ``{"kinetic", "kinetic_full_step", "strain", "external_work", "coupling_work",
-            "constraint_work", "damping_work"}``, block name -> float. ``kinetic`` is the
-            scheme's energy form (central differences: ½ ṽ^{n−½}·M v^{n+½}, whose balance closes
-            to round-off for linear systems), ``kinetic_full_step`` ½ vᵀM v of v at t.
+            ``{"kinetic", "kinetic_full_step", "strain", "stored", "dissipation",
+            "external_work", "coupling_work", "constraint_work", "damping_work"}``, block name
+            -> float. ``kinetic`` is the scheme's energy form (central differences:
+            ½ ṽ^{n−½}·M v^{n+½}, whose balance closes to round-off for linear systems),
+            ``kinetic_full_step`` ½ vᵀM v of v at t. ``strain``: ½ uᵀK u of linear blocks, the
+            accumulated work of the internal forces of nonlinear ones; ``stored`` and
+            ``dissipation``: the models' own stored energy and plastic dissipation of their
+            committed states where they offer them (optional members ``stored_energy_of_state``
+            and ``plastic_dissipation``, see :meth:`SystemOperators.stored_and_dissipated`),
+            else ``strain`` and 0.
         """
         names = self.ops.names
         kin = self._kinetic()
         full = self.ops.kinetic(self.v)
         strain = self.ops.strain_linear(self.u)
         lin = np.asarray(self.ops.block_linear)
+        stored, dissipated = self.ops.stored_and_dissipated(self.states, self._w_internal)
+        stored = np.where(lin, strain, stored)
         strain = np.where(lin, strain, self._w_internal)
         w_ext, w_coupling, w_constraint = self._works()
         return {
             "kinetic": dict(zip(names, kin.tolist())),
             "kinetic_full_step": dict(zip(names, full.tolist())),
             "strain": dict(zip(names, strain.tolist())),
+            "stored": dict(zip(names, stored.tolist())),
+            "dissipation": dict(zip(names, dissipated.tolist())),
             "external_work": dict(zip(names, w_ext.tolist())),
             "coupling_work": dict(zip(names, w_coupling.tolist())),
             "constraint_work": dict(zip(names, w_constraint.tolist())),

@@ -6,6 +6,12 @@ model's ``internal_force(u, state, weight) -> (f, trial_state)`` with the commit
 term and, when a tangent is asked for, ``tangent(u, state, weight)`` (capability ``"tangent"``
 of :mod:`arlequin.contract`) or, with ``tangent="initial"``, the model's ``stiffness(weight)``
 (a modified Newton iteration: the documented alternative for models without a tangent).
+
+Energies of nonlinear blocks: the integrators accumulate the work of the internal forces; a block
+whose every term's model offers the optional members ``stored_energy_of_state(state, weight)``
+and ``plastic_dissipation(state, weight)`` (:mod:`arlequin.contract`, :class:`DynamicModel`)
+also reports its stored energy and its plastic dissipation from the committed states
+(:meth:`SystemOperators.stored_and_dissipated`).
 """
 
 from __future__ import annotations
@@ -275,6 +281,45 @@ class SystemOperators:
     def kinetic(self, v: np.ndarray) -> np.ndarray:
         """α-weighted kinetic energy per block (J) with the integrator's mass."""
         return 0.5 * self.block_dots(v, self.mass_times(v))
+
+    def stored_and_dissipated(
+        self, states: Mapping[str, list[Any]], internal_work: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Stored energy and plastic dissipation per nonlinear block (J) from committed states.
+
+        A nonlinear block whose every term's model has the optional members
+        ``stored_energy_of_state(state, weight)`` and ``plastic_dissipation(state, weight)``
+        (found with ``getattr``, see :class:`arlequin.contract.DynamicModel`) gets
+        Σ_terms sign × those; the others (and a model that raises ``ValueError`` there, e.g.
+        :class:`FiniteStrainJ2` with bulk viscosity) keep ``internal_work`` as their stored
+        energy and no dissipation. Linear blocks: 0 and 0 (their ½ uᵀK u is added by the caller).
+        """
+        stored = np.zeros(len(self.blocks))
+        dissipated = np.zeros(len(self.blocks))
+        for bi, (b, lin) in enumerate(zip(self.blocks, self.block_linear)):
+            if lin:
+                continue
+            parts = self._block_energy_parts(b, states[b.name])
+            if parts is None:
+                stored[bi] = internal_work[bi]
+            else:
+                stored[bi], dissipated[bi] = parts
+        return stored, dissipated
+
+    @staticmethod
+    def _block_energy_parts(b: Block, states: list[Any]) -> tuple[float, float] | None:
+        stored = dissipated = 0.0
+        for t, state in zip(b.terms, states):
+            psi = getattr(t.model, "stored_energy_of_state", None)
+            dis = getattr(t.model, "plastic_dissipation", None)
+            if not (callable(psi) and callable(dis)) or state is None:
+                return None
+            try:
+                stored += t.sign * float(psi(state, t.weight))
+                dissipated += t.sign * float(dis(state, t.weight))
+            except ValueError:
+                return None
+        return stored, dissipated
 
     def strain_linear(self, u: np.ndarray) -> np.ndarray:
         """½ uᵀ K u per block (J) for the linear blocks (0 for the others)."""

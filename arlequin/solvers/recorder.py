@@ -87,8 +87,14 @@ class Recorder:
         it = self.integ
         names = it.ops.names
 
-        def hist(key: str) -> dict[str, np.ndarray]:
-            return {n: np.array([r[key][n] for r in self.rows]) for n in names}
+        def hist(key: str, default: str | None = None) -> dict[str, np.ndarray]:
+            # rows of a run resumed from an older checkpoint may lack the newer keys
+            def value(r: dict, n: str) -> float:
+                if key in r:
+                    return r[key][n]
+                return r[default][n] if default else 0.0
+
+            return {n: np.array([value(r, n) for r in self.rows]) for n in names}
 
         fields = None
         if self.save_fields:
@@ -100,6 +106,8 @@ class Recorder:
             kinetic=hist("kinetic"),
             kinetic_full_step=hist("kinetic_full_step"),
             strain=hist("strain"),
+            stored=hist("stored", "strain"),
+            dissipation=hist("dissipation"),
             external_work=hist("external_work"),
             coupling_work=hist("coupling_work"),
             constraint_work=hist("constraint_work"),

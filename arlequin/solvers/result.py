@@ -5,13 +5,22 @@ Energy accounting (every integrator): per block (model) b,
 * kinetic energy ``T_b = ½ v_bᵀ M_b v_b`` with the α-weighted mass of the integrator (lumped for
   the explicit scheme), strain energy ``U_b = ½ u_bᵀ K_b u_b`` (α-weighted; nonlinear blocks: the
   accumulated work of the internal forces);
+* stored energy ``S_b`` and plastic dissipation ``D_b``: the models' own, from their committed
+  states, for nonlinear blocks whose models offer the optional members
+  ``stored_energy_of_state(state, weight)`` and ``plastic_dissipation(state, weight)``
+  (:class:`arlequin.contract.DynamicModel`); else ``S_b = U_b`` and ``D_b = 0``;
 * work of the external forces ``W_ext,b``, of the coupling (mediator) forces ``W_c,b`` and of the
   other constraint forces (Dirichlet reactions, contact) ``W_r,b``, accumulated from the forces
   and the displacement increments / velocities of the steps (never as a balance residual).
 
 The coupling forces on the two models are opposite (−C_cᵀλ and +C_fᵀλ): their works on the coarse
 and on the fine block cancel when the coupled velocities satisfy C_c v_c = C_f v_f. The balance
-``E − E(0) − W_ext − W_c − W_r`` (E = Σ T_b + U_b) measures the numerical energy error.
+``E − E(0) − W_ext − W_c − W_r`` (E = Σ T_b + U_b) measures the numerical energy error. With
+nonlinear blocks U_b is the internal work, so that balance is the scheme's own; the *material*
+balance ``material_balance`` writes it with the models' stored energy and dissipation instead,
+``T + S + D − (T + S + D)(0) − W``: it also measures how far the scheme's internal work is from
+the constitutive update's (the trapezoidal rule on the forces against the return map's
+backward-Euler dissipation).
 Units: J for energies and works. Multipliers λ are such that the force on the system is −Bᵀλ
 (N): their unit is N over the unit of their rows (Dirichlet rows: N; mediator rows, of
 ∫ψ·φ: N/m³, N/m for 1D bars; contact rows −W G: Pa).
@@ -78,6 +87,10 @@ class DynamicResult:
     damping_work : dict
         Block name -> work of the damping forces since the start (J, ≤ 0), shape (n_rec,):
         zeros without :class:`~arlequin.solvers.RayleighDamping`.
+    stored, dissipation : dict
+        Block name -> stored energy and accumulated plastic dissipation (J), shape (n_rec,),
+        of the models that offer them (``stored_energy_of_state``, ``plastic_dissipation``);
+        else ``strain`` and zeros (linear blocks: ½ uᵀK u and zeros).
     """
 
     times: np.ndarray
@@ -104,6 +117,8 @@ class DynamicResult:
     constraint_records: dict[str, list[Any]] = field(default_factory=dict, repr=False)
     kinetic_full_step: dict[str, np.ndarray] = field(default_factory=dict)
     damping_work: dict[str, np.ndarray] = field(default_factory=dict)
+    stored: dict[str, np.ndarray] = field(default_factory=dict)
+    dissipation: dict[str, np.ndarray] = field(default_factory=dict)
 
     @property
     def success(self) -> bool:
@@ -148,6 +163,31 @@ class DynamicResult:
     def balance(self) -> np.ndarray:
         """E − E(0) − W_ext − W_c − W_r − W_d (J): the numerical energy error, shape (n_rec,)."""
         e = self.total_energy
+        return (
+            e
+            - e[0]
+            - self.total_external_work
+            - self.total_coupling_work
+            - self.total_constraint_work
+            - self.total_damping_work
+        )
+
+    @property
+    def total_stored(self) -> np.ndarray:
+        """Σ_b S_b (J), shape (n_rec,) (``strain`` where no block reports its stored energy)."""
+        return self._sum(self.stored, self.times.size) if self.stored else self.total_strain
+
+    @property
+    def total_dissipation(self) -> np.ndarray:
+        """Σ_b D_b, the plastic dissipation of the models that report it (J), shape (n_rec,)."""
+        return self._sum(self.dissipation, self.times.size)
+
+    @property
+    def material_balance(self) -> np.ndarray:
+        """T + S + D − (T + S + D)(0) − W_ext − W_c − W_r − W_d (J), shape (n_rec,): the
+        balance with the models' stored energy and plastic dissipation (see the module
+        docstring); equal to :attr:`balance` for linear systems."""
+        e = self.total_kinetic + self.total_stored + self.total_dissipation
         return (
             e
             - e[0]

@@ -587,6 +587,12 @@ class SmallStrainJ2:
             psi = psi + 0.75 * np.sum(state.back_stress**2, axis=0) / self.kinematic_modulus
         return float(np.sum(self._weights(weight) * psi))
 
+    def stored_energy_of_state(self, state: SmallStrainState, weight: WeightLike = None) -> float:
+        """:meth:`stored_energy` (J), under the name the integrators' energy accounting looks
+        for (optional member of :class:`arlequin.contract.DynamicModel`, as
+        ``FiniteStrainJ2.stored_energy_of_state``)."""
+        return self.stored_energy(state, weight)
+
     def plastic_dissipation(self, state: SmallStrainState, weight: WeightLike = None) -> float:
         """Accumulated plastic dissipation Σ α dV Σ_steps σ_y(ε̄p) Δε̄p (J)."""
         return float(np.sum(self._weights(weight) * state.plastic_work))
