@@ -143,7 +143,8 @@ class DynamicModel(Protocol):
     Optional members: ``n_components`` (default 1), ``initial_state(weight)`` (default None:
     the first ``internal_force`` call gets ``state=None``) and ``uses_time_step`` (default
     False): when True, the integrators call ``internal_force(u, state, weight, dt=h)`` with h
-    (s) the step that leads to u (None at the initial time), for rate-dependent state updates.
+    (s) the step that leads to u (None at the initial time), for rate-dependent state updates,
+    and ``tangent(u, state, weight, dt=h)`` likewise (the derivative of that force).
 
     Energy members (optional, looked up with ``getattr``; both or neither):
     ``stored_energy_of_state(state, weight) -> float``, the stored (recoverable) energy of a

@@ -254,7 +254,7 @@ class _RecordsTimeStep:
     uses_time_step = True
 
     def __init__(self, model):
-        self.model, self.n_dofs, self.seen = model, model.n_dofs, []
+        self.model, self.n_dofs, self.seen, self.seen_by_tangent = model, model.n_dofs, [], []
 
     def mass(self, weight=None, lumped=False):
         return self.model.mass(weight, lumped=lumped)
@@ -266,7 +266,8 @@ class _RecordsTimeStep:
         self.seen.append(dt)
         return self.model.stiffness(weight) @ u, None
 
-    def tangent(self, u, state=None, weight=None):
+    def tangent(self, u, state=None, weight=None, dt=None):
+        self.seen_by_tangent.append(dt)
         return self.model.stiffness(weight)
 
 
@@ -284,3 +285,5 @@ def test_models_that_use_the_time_step_receive_it(scheme):
     solve(system, scheme, dt=schedule, n_steps=3, v0=np.ones(bar.n_dofs))
     assert model.seen[0] is None  # the initial evaluation
     assert sorted(set(model.seen[1:])) == sorted(set(steps))  # every later call: its step
+    if scheme == "newmark":  # Newton's tangent: the same step as the force it derives
+        assert model.seen_by_tangent and set(model.seen_by_tangent) <= set(steps)

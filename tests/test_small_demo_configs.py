@@ -108,7 +108,7 @@ def test_bad_value_same_error_from_cli_and_python(argv, python, needle, capsys, 
 
 
 def test_study_checks_with_the_configuration():
-    from arlequin.demos.study_spec import StudyError, load_spec
+    from arlequin.demos.study import StudyError, load_spec
 
     with pytest.raises(StudyError, match="epsilon must be finite"):
         load_spec({"demo": "wave", "parameters": {"epsilon": float("nan")}})

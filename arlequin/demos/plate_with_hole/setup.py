@@ -101,9 +101,11 @@ class ZonedPlate:
         self._system: CoupledSystem | None = None
 
     def add_dirichlet(self, block: str, where, components=None, **kwargs: Any) -> None:
+        """Prescribe displacements on the plate's nodes (as ``ArlequinProblem.add_dirichlet``)."""
         self.problem.add_dirichlet(block, where, components=components, **kwargs)
 
     def add_traction(self, traction, where=None) -> None:
+        """A traction (Pa) on the plate's boundary facets selected by ``where``."""
         self.problem.add_traction(traction, where=where)
 
     def system(self) -> CoupledSystem:
@@ -117,6 +119,7 @@ class ZonedPlate:
         return self._system
 
     def field_layout(self):
+        """The plate's mesh and its cell data for a results folder."""
         return self.problem.field_layout()
 
 

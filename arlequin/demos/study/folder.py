@@ -30,10 +30,12 @@ class StudyIndex:
         self.write()
 
     def set(self, case_id: str, **entry: Any) -> None:
+        """Update a case's entry (status, error, results) and rewrite the index."""
         self.cases[case_id].update(entry)
         self.write()
 
     def write(self) -> None:
+        """Rewrite ``index.json`` atomically (write, then rename)."""
         tmp = self.path.with_suffix(".tmp")
         tmp.write_text(json.dumps({"demo": self.demo, "cases": self.cases}, indent=2,
                                   default=float))  # fmt: skip
@@ -41,6 +43,8 @@ class StudyIndex:
 
 
 def write_table(root: Path, index: StudyIndex, spec: StudySpec) -> list[dict[str, Any]]:
+    """``results.csv`` (and ``results.parquet`` with pandas and pyarrow): one row per completed
+    case, its parameters and scalar results; returns the table (a DataFrame with pandas)."""
     rows = []
     for c in spec.cases:
         entry = index.cases[c.case_id]
