@@ -56,7 +56,8 @@ _map_models_folder()
 def numba_cache_dir() -> str:
     """Where numba keeps the compiled kernels of this package (``cache=True``): the
     ``NUMBA_CACHE_DIR`` environment variable if set, else a per-user cache directory,
-    ``$XDG_CACHE_HOME/arlequin/numba`` (``~/.cache/arlequin/numba`` by default).
+    ``$XDG_CACHE_HOME/arlequin/numba`` (``~/.cache/arlequin/numba`` by default), or a folder of
+    the temporary directory where that cannot be written.
 
     Never inside the installed package: a cache there outlives ``pip uninstall`` (the
     leftover folder then shadows ``arlequin.models`` of the next installation) and cannot be
@@ -69,7 +70,17 @@ def numba_cache_dir() -> str:
     if given:
         return given
     base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-    return os.path.join(base, "arlequin", "numba")
+    path = os.path.join(base, "arlequin", "numba")
+    try:
+        os.makedirs(path, exist_ok=True)
+        if os.access(path, os.W_OK):
+            return path
+    except OSError:
+        pass
+    # no writable home (a service account): the temporary directory, one folder per user
+    import tempfile
+
+    return os.path.join(tempfile.gettempdir(), f"arlequin-numba-{os.getuid()}")
 
 
 def _cache_kernels_outside_the_package() -> None:

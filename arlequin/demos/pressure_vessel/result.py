@@ -29,6 +29,7 @@ UNITS = {
     "newton_iterations": "1",
     "residuals": "1",
     "reference": "",
+    "max_coarse_yield_ratio": "1",
 }
 
 
@@ -59,6 +60,10 @@ class PressureVesselResult(JsonResult):
         step's relative residuals; 0 and [] for the initial state).
     reference : dict
         Hill's values at the final pressure (sphere), first yield and the limit load.
+    max_coarse_yield_ratio : float
+        The largest von Mises stress / σy of the coarse elastic model outside the patch over
+        the run (0 for ``mono``); above 1 the run warns (``CoarseYieldWarning``): the plastic
+        zone has outgrown the patch.
     """
 
     first_yield_pressure: float
@@ -70,6 +75,7 @@ class PressureVesselResult(JsonResult):
     wall_time_s: float
     history: dict[str, list[Any]]
     reference: dict[str, float] = field(default_factory=dict)
+    max_coarse_yield_ratio: float = 0.0
     config: dict[str, Any] = field(default_factory=dict)
 
     json_exclude = ("config",)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import logging
 import time
+import warnings
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
@@ -26,7 +27,12 @@ from .setup import VesselSetup, build
 if TYPE_CHECKING:  # annotations only: the configuration runs this module
     from .config import PressureVesselConfig
 
-__all__ = ["run"]
+__all__ = ["CoarseYieldWarning", "run"]
+
+
+class CoarseYieldWarning(UserWarning):
+    """The coarse elastic model carries stresses above the yield stress outside the patch."""
+
 
 logger = logging.getLogger(__name__)
 
@@ -83,6 +89,26 @@ class _Recorder:
         state = solver.states[self.setup.plastic_block][0]
         self._append(self.pressure(solver), solver.u, state, rec.iterations, rec.residuals,
                      solver.t)  # fmt: skip
+        self.max_coarse_yield_ratio = max(self.max_coarse_yield_ratio, self._coarse_ratio(solver))
+
+    max_coarse_yield_ratio = 0.0
+
+    def _coarse_ratio(self, solver: Any) -> float:
+        """The largest von Mises / σy of the coarse elastic model outside the patch (0 for
+        ``mono``): above 1, the coarse model carries stresses the material cannot."""
+        if self.setup.plastic_block == "coarse":
+            return 0.0
+        problem = self.setup.problem
+        coarse = problem.coarse
+        u = solver.u[solver.system.dofmap["coarse"].slice]
+        outside = np.ones(coarse.mesh.nelements, dtype=bool)
+        outside[problem.couplings[0].overlap.coarse_cells] = False  # the patch's coarse cells
+        if not np.any(outside):
+            return 0.0
+        s = coarse.stress_at_quadrature(u)[:, :, outside]
+        dev = s - np.einsum("ii...->...", s)[None, None] / 3.0 * np.eye(3)[:, :, None, None]
+        vm = np.sqrt(1.5 * np.einsum("ij...,ij...->...", dev, dev))
+        return float(vm.max() / self.config.yield_stress)
 
 
 def _bore_area(setup: VesselSetup, a: float) -> float:
@@ -180,8 +206,18 @@ def run(config: PressureVesselConfig, out: str | None = None,
         wall_time_s=time.perf_counter() - start,
         history=recorder.history,
         reference=_reference(config, recorder.history["pressure"][-1]),
+        max_coarse_yield_ratio=recorder.max_coarse_yield_ratio,
         config=config.inputs(),
     )
+    if recorder.max_coarse_yield_ratio > 1.0:
+        warnings.warn(
+            f"the coarse elastic model outside the patch carries von Mises stresses up to "
+            f"{recorder.max_coarse_yield_ratio:.3f} times the yield stress: the plastic zone "
+            "has outgrown the patch, and the results past that load are not those of the J2 "
+            "material (widen --patch-outer, or use --model mono)",
+            CoarseYieldWarning,
+            stacklevel=2,
+        )
     if folder is not None:
         folder.add_results({k: v for k, v in result.to_json().items()}, UNITS)
         write_pictures(folder, setup, qs, result)
