@@ -170,3 +170,44 @@ def test_cli_writes_the_interface_json_and_a_results_folder(tmp_path, capsys):
     assert (out / "pressure_displacement.png").exists() and (out / "plastic_zone.png").exists()
     assert "first yield" in capsys.readouterr().out
     assert math.isfinite(data["first_yield_pressure"])
+
+
+def test_an_interrupted_run_resumes_bit_for_bit(tmp_path, monkeypatch):
+    """A run interrupted after its 6th converged step continues with ``--resume --out DIR``
+    from its checkpoint: the same history (pressures, displacements, fronts, Newton's
+    iterations and residuals) as the uninterrupted run, bit for bit, and every frame kept."""
+    import arlequin.solvers.quasi_static as qs
+    from arlequin.cli.main import main
+    from arlequin.demos.pressure_vessel import run as run_module
+    from arlequin.io import read_series
+
+    args = ["pressure-vessel", "--coarse-size", "0.025", "--fine-size", "0.00625", "--steps",
+            "10", "--quiet"]  # fmt: skip
+    full, cut = tmp_path / "full", tmp_path / "cut"
+    assert main([*args, "--out", str(full), "--json", str(tmp_path / "full.json")]) == 0
+
+    class Interrupted(Exception):
+        pass
+
+    original, calls = qs.QuasiStaticSolver.step, []
+
+    def step(self):
+        calls.append(1)
+        if len(calls) == 7:
+            raise Interrupted
+        return original(self)
+
+    monkeypatch.setattr(qs.QuasiStaticSolver, "step", step)
+    with pytest.raises(Interrupted):
+        run_module.run(PressureVesselConfig(coarse_size=0.025, fine_size=0.00625, steps=10),
+                       out=str(cut))  # fmt: skip
+    monkeypatch.setattr(qs.QuasiStaticSolver, "step", original)
+    # other options than the run's are refused with --resume
+    assert main(["pressure-vessel", "--resume", "--out", str(cut), "--steps", "3"]) == 2
+    assert main(["pressure-vessel", "--resume", "--out", str(cut), "--quiet", "--json",
+                 str(tmp_path / "cut.json")]) == 0  # fmt: skip
+    a = json.loads((tmp_path / "full.json").read_text())["history"]
+    b = json.loads((tmp_path / "cut.json").read_text())["history"]
+    assert a == b
+    assert len(read_series(cut / "fields" / "patch0.xdmf")[1]) == 10
+    assert main(["pressure-vessel", "--resume", "--out", str(tmp_path / "none")]) == 2

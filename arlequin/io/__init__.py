@@ -7,6 +7,7 @@
 demos and the CLI do.
 """
 
+from .checkpoint import CheckpointError, read_checkpoint, write_checkpoint
 from .fields import FieldSeries, meshio_mesh, read_series
 from .folder import RESULTS_JSON, JsonResult, ResultsFolder, environment, jsonable
 from .history import HistoryCSV, read_history
@@ -17,6 +18,7 @@ from .run import DynamicRunWriter, QuasiStaticRunWriter, write_static
 __all__ = [
     "RESULTS_JSON",
     "BlockFields",
+    "CheckpointError",
     "DynamicRunWriter",
     "FieldLayout",
     "FieldSeries",
@@ -28,8 +30,10 @@ __all__ = [
     "environment",
     "jsonable",
     "meshio_mesh",
+    "read_checkpoint",
     "read_history",
     "read_mesh",
     "read_series",
+    "write_checkpoint",
     "write_static",
 ]

@@ -8,12 +8,16 @@ balance) and, at the frame times, a frame of every block's field series.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Sequence
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from .fields import read_series
 from .folder import ResultsFolder
+from .history import read_history
 from .layout import FieldLayout
 
 __all__ = ["DynamicRunWriter", "QuasiStaticRunWriter", "write_static"]
@@ -126,7 +130,8 @@ class QuasiStaticRunWriter:
                "cuts")  # fmt: skip
 
     def __init__(self, folder: ResultsFolder, system: Any, layout: FieldLayout,
-                 cell_data: Any = None, units: dict[str, str] | None = None) -> None:  # fmt: skip
+                 cell_data: Any = None, units: dict[str, str] | None = None,
+                 replay: dict[str, Any] | None = None) -> None:  # fmt: skip
         self.system, self.layout, self.cell_data = system, layout, cell_data
         self.history = folder.history(
             self.columns,
@@ -142,6 +147,28 @@ class QuasiStaticRunWriter:
         )
         self.series = {bf.name: folder.series(bf.name, bf.mesh) for bf in layout.blocks}
         folder.meta.setdefault("field_units", {}).update({**layout.units, **(units or {})})
+        if replay is not None:  # a resumed run: what the interrupted one had written, first
+            for row in replay["rows"]:
+                self.history.append(row)
+            for name, frames in replay["frames"].items():
+                for t, point, cell in frames:  # meshio gives cell data per cell block
+                    cell = {k: v[0] if isinstance(v, list) else v for k, v in cell.items()}
+                    self.series[name].write(t, point, cell)
+
+    @staticmethod
+    def written(out: str | os.PathLike) -> dict[str, Any]:
+        """What a writer had written in the folder ``out``: its rows and every series'
+        frames (read before a resumed run's writer opens the files again)."""
+        out = Path(out)
+        rows: list[dict[str, float]] = []
+        path = out / "newton.csv"
+        if path.is_file():
+            cols = read_history(path)
+            rows = [dict(zip(cols, vals)) for vals in zip(*cols.values())]
+        frames = {
+            p.stem: read_series(p)[1] for p in sorted((out / "fields").glob("*.xdmf"))
+        }  # fmt: skip
+        return {"rows": rows, "frames": frames}
 
     def __call__(self, solver: Any) -> None:
         rec = solver.history[-1]

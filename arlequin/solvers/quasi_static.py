@@ -184,6 +184,10 @@ class QuasiStaticSolver:
         are taken as those of λ = 1 (default 1).
     t0, u0, states :
         Start (default λ = 0, zero displacement, the models' initial states).
+    restore : dict, optional
+        A :meth:`snapshot` of an interrupted run of the same problem and options: the solver
+        continues from its last converged step, with the same steps and values as the
+        uninterrupted run.
     """
 
     def __init__(
@@ -204,6 +208,7 @@ class QuasiStaticSolver:
         t0: float = 0.0,
         u0: Any = None,
         states: dict[str, list[Any]] | None = None,
+        restore: dict[str, Any] | None = None,
     ) -> None:
         self.system = as_system(system)
         _check_inputs(load, steps, tol, max_iterations, growth, t0)
@@ -236,6 +241,8 @@ class QuasiStaticSolver:
         self._first_stiffness: float | None = None
         self._last_stiffness: float | None = None
         self.status = "running"
+        if restore is not None:
+            self._restore(restore)
 
     # -- loads -------------------------------------------------------------------------------
     def external_force(self, lam: float) -> np.ndarray:
@@ -415,6 +422,28 @@ class QuasiStaticSolver:
             time=self.t + dt,
         )
 
+    # -- checkpoints -------------------------------------------------------------------------
+    _SNAPSHOT = ("t", "u", "mu", "states", "dt", "history", "status", "_previous",
+                 "_first_stiffness", "_last_stiffness")  # fmt: skip
+
+    def snapshot(self) -> dict[str, Any]:
+        """The committed state of the run (picklable: arrays and immutable states), from which
+        ``QuasiStaticSolver(..., restore=snapshot)`` continues bit for bit."""
+        return {name: getattr(self, name) for name in self._SNAPSHOT}
+
+    def _restore(self, snap: dict[str, Any]) -> None:
+        missing = [name for name in self._SNAPSHOT if name not in snap]
+        if missing:
+            raise ValueError(f"restore: the snapshot lacks {missing}")
+        if np.shape(snap["u"]) != self.u.shape or np.shape(snap["mu"]) != self.mu.shape:
+            raise ValueError(
+                f"restore: the snapshot is of another problem ({np.size(snap['u'])} dofs and "
+                f"{np.size(snap['mu'])} multipliers, this one {self.u.size} and {self.mu.size})"
+            )
+        for name in self._SNAPSHOT:
+            setattr(self, name, snap[name])
+        self.history = list(self.history)
+
     # -- results -----------------------------------------------------------------------------
     def reactions(self) -> np.ndarray:
         """Reaction forces (N) at the Dirichlet dofs, zero elsewhere."""
@@ -482,7 +511,7 @@ def solve_quasi_static(
     **options
         Passed to :class:`QuasiStaticSolver` (``proportional``, ``tol``, ``max_iterations``,
         ``min_step``, ``growth``, ``line_search``, ``condense``, ``reference_time``, ``t0``,
-        ``u0``, ``states``).
+        ``u0``, ``states``, ``restore``).
 
     Returns
     -------

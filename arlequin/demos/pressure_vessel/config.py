@@ -26,6 +26,7 @@ class PressureVesselConfig(DemoConfig):
     pressure, J2 plasticity (see :mod:`arlequin.demos.pressure_vessel`)."""
 
     command: ClassVar[str] = "pressure-vessel"
+    switches: ClassVar[tuple[str, ...]] = ("json", "quiet", "resume", "out")
     title: ClassVar[str] = (
         "thick sphere or cylinder under internal pressure, J2 plasticity, against Hill's "
         "solutions (quasi-static, Newton)"
@@ -155,6 +156,23 @@ class PressureVesselConfig(DemoConfig):
 
     # -- running -----------------------------------------------------------------------------
     def run(self, out: str | None = None, progress: Callable[[float], None] | None = None) -> Any:
+        """Run the vessel (:func:`arlequin.demos.pressure_vessel.run.run`)."""
         from .run import run
 
         return run(self, out=out, progress=progress)
+
+    def progress_scale(self) -> tuple[float, str, float, str]:
+        """The bar shows the load factor in percent."""
+        return 100.0, "% load", 100.0, self.command
+
+    @classmethod
+    def resume(cls, out: str, progress: Callable[[float], None] | None = None) -> Any:
+        """Continue the interrupted run of the results folder ``out`` from its checkpoint."""
+        from .run import resume
+
+        return resume(out, progress=progress)
+
+    @classmethod
+    def resume_progress_scale(cls, out: str) -> tuple[float, str, float, str]:
+        """The bar of a resumed run (as the run's)."""
+        return 100.0, "% load", 100.0, cls.command

@@ -6,11 +6,12 @@ import logging
 import time
 import warnings
 from collections.abc import Callable
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ...io import QuasiStaticRunWriter, ResultsFolder
+from ...io import QuasiStaticRunWriter, ResultsFolder, read_checkpoint, write_checkpoint
 from ...solvers import NewtonError, solve_quasi_static
 from .hill import (
     cylinder_first_yield,
@@ -27,7 +28,7 @@ from .setup import VesselSetup, build
 if TYPE_CHECKING:  # annotations only: the configuration runs this module
     from .config import PressureVesselConfig
 
-__all__ = ["CoarseYieldWarning", "run"]
+__all__ = ["CHECKPOINT", "CoarseYieldWarning", "resume", "run"]
 
 
 class CoarseYieldWarning(UserWarning):
@@ -160,50 +161,93 @@ def _reference(config: PressureVesselConfig, pressure: float) -> dict[str, float
     }
 
 
-def run(config: PressureVesselConfig, out: str | None = None,
-        progress: Callable[[float], None] | None = None) -> PressureVesselResult:  # fmt: skip
-    """Run the vessel of ``config`` (see :mod:`arlequin.demos.pressure_vessel`)."""
-    from .report import cell_fields, write_pictures
+CHECKPOINT = "checkpoint.pkl"
 
+
+def run(config: PressureVesselConfig, out: str | None = None,
+        progress: Callable[[float], None] | None = None,
+        restore: dict[str, Any] | None = None) -> PressureVesselResult:  # fmt: skip
+    """Run the vessel of ``config`` (see :mod:`arlequin.demos.pressure_vessel`); ``restore``
+    (a checkpoint of ``out``, :func:`resume`) continues an interrupted run."""
     start = time.perf_counter()
     setup = build(config)
-    system = setup.problem.system()
     folder = (
         ResultsFolder(out, "arlequin pressure-vessel", config.inputs(), config.units())
         if out
         else None
     )
     recorder = _Recorder(config, setup, _bore_area(setup, config.inner))
-    listeners: list[Callable[[Any], Any]] = [recorder]
-    if folder is not None:
-        layout = setup.problem.field_layout()
-        units = {"eqps": "1", "von_mises": "Pa"}
-        writer = QuasiStaticRunWriter(folder, system, layout, cell_fields(setup), units)
-        listeners.append(writer)
-    if progress is not None:
-        listeners.append(lambda solver: progress(solver.t))
-    try:
+    if restore is not None:
+        recorder.history = restore["history"]
+        recorder.max_coarse_yield_ratio = restore["max_coarse_yield_ratio"]
+        first_yield = restore["first_yield_pressure"]
+    else:
         first_yield = _first_yield(config, setup)
-        qs = solve_quasi_static(setup.problem, load=1.0, steps=config.steps, on_step=listeners)
+    listeners = _listeners(config, setup, folder, recorder, first_yield, progress, restore)
+    try:
+        qs = solve_quasi_static(
+            setup.problem, load=1.0, steps=config.steps, on_step=listeners,
+            restore=None if restore is None else restore["solver"],
+        )  # fmt: skip
     except NewtonError as err:
         if folder is not None:
             folder.add_results({"history": recorder.history})
             folder.finish("failed", str(err))
         raise
+    result = _result(config, setup, qs, recorder, first_yield, time.perf_counter() - start)
+    if folder is not None:
+        from .report import write_pictures
+
+        folder.add_results(dict(result.to_json()), UNITS)
+        write_pictures(folder, setup, qs, result)
+        folder.finish("complete", qs.message)
+    logger.info("%s", result.summary())
+    return result
+
+
+def _listeners(config, setup, folder, recorder, first_yield, progress, restore) -> list:
+    """What each converged step calls: the recorder, the results folder's writer (the frames
+    and rows of a resumed run first written again), the checkpoint, the progress."""
+    listeners: list[Callable[[Any], Any]] = [recorder]
+    if folder is not None:
+        from .report import cell_fields
+
+        system = setup.problem.system()
+        layout = setup.problem.field_layout()
+        units = {"eqps": "1", "von_mises": "Pa"}
+        replay = None if restore is None else restore["replay"]
+        writer = QuasiStaticRunWriter(folder, system, layout, cell_fields(setup), units,
+                                      replay=replay)  # fmt: skip
+        path = folder.path / CHECKPOINT
+
+        def checkpoint(solver: Any) -> None:
+            write_checkpoint(path, {
+                "config": config, "solver": solver.snapshot(), "history": recorder.history,
+                "max_coarse_yield_ratio": recorder.max_coarse_yield_ratio,
+                "first_yield_pressure": first_yield,
+            })  # fmt: skip
+
+        listeners += [writer, checkpoint]
+    if progress is not None:
+        listeners.append(lambda solver: progress(solver.t))
+    return listeners
+
+
+def _result(config, setup, qs, recorder, first_yield, wall) -> PressureVesselResult:
+    """The result of a finished run (its warning if the patch was outgrown)."""
     mesh = setup.meshes
     n_el = (mesh.mono.nelements if mesh.mono is not None
             else mesh.coarse.nelements + mesh.patch.nelements)  # fmt: skip
-    area = _area(mesh.coarse)
-    fraction = 1.0 if mesh.patch is None else _area(mesh.patch) / area
+    fraction = 1.0 if mesh.patch is None else _area(mesh.patch) / _area(mesh.coarse)
     limit = qs.status == "limit_load"
     result = PressureVesselResult(
         first_yield_pressure=first_yield,
         limit_load_reached=limit,
         limit_load=recorder.history["pressure"][-1] if limit else None,
         n_elements=int(n_el),
-        n_dofs=int(system.n_dofs),
+        n_dofs=int(setup.problem.system().n_dofs),
         patch_fraction=float(fraction),
-        wall_time_s=time.perf_counter() - start,
+        wall_time_s=wall,
         history=recorder.history,
         reference=_reference(config, recorder.history["pressure"][-1]),
         max_coarse_yield_ratio=recorder.max_coarse_yield_ratio,
@@ -216,14 +260,18 @@ def run(config: PressureVesselConfig, out: str | None = None,
             "has outgrown the patch, and the results past that load are not those of the J2 "
             "material (widen --patch-outer, or use --model mono)",
             CoarseYieldWarning,
-            stacklevel=2,
+            stacklevel=3,
         )
-    if folder is not None:
-        folder.add_results({k: v for k, v in result.to_json().items()}, UNITS)
-        write_pictures(folder, setup, qs, result)
-        folder.finish("complete", qs.message)
-    logger.info("%s", result.summary())
     return result
+
+
+def resume(out: str, progress: Callable[[float], None] | None = None) -> PressureVesselResult:
+    """Continue the interrupted run whose results folder is ``out`` from its last converged
+    step (its checkpoint), with the inputs it was started with; the same steps and values as
+    the uninterrupted run."""
+    snap = read_checkpoint(Path(out) / CHECKPOINT)
+    snap["replay"] = QuasiStaticRunWriter.written(out)
+    return run(snap["config"], out=out, progress=progress, restore=snap)
 
 
 def _area(mesh: Any) -> float:
