@@ -29,10 +29,11 @@ import skfem
 
 from ...coupling.exactness import ExactnessWarning
 from ...coupling.gluing import Patch
+from ...coupling.weights import RampWeights
 from ...models import IsotropicElastic, J2Material, LinearElastic
 from ...problem.arlequin_problem import ArlequinProblem
 from ...problem.system import Block, BlockTerm, CoupledSystem
-from .meshes import graded_plate_mesh, quarter_plate_mesh, refine_projected
+from .meshes import graded_plate_mesh, plate_mesh, refine_projected, square_radius
 
 if TYPE_CHECKING:  # annotations only: the configuration runs this module
     from .config import PlateWithHoleConfig
@@ -185,7 +186,8 @@ def area(mesh: Any) -> float:
 def build(config: PlateWithHoleConfig) -> PlateSetup:
     """The problem of ``config`` (supports, and the traction at λ = 1: the final load S)."""
     a, w, lv = config.radius, config.width, config.levels
-    coarse, ring, radii = quarter_plate_mesh(a, config.n_theta, config.n_radial, "quad", w)
+    coarse, lines = plate_mesh(a, config.n_theta, config.n_radial, w, config.block)
+    cells = np.nonzero(square_radius(coarse) <= config.patch_square * (1.0 + 1e-12))[0]
     make_j2 = j2_factory(config)
     elastic = IsotropicElastic(config.young, config.poisson, DENSITY)
     kind = "plane_strain"
@@ -197,18 +199,17 @@ def build(config: PlateWithHoleConfig) -> PlateSetup:
         blocks, block, loaded, n_el = ["coarse"], "coarse", plastic, plastic.mesh.nelements
         fraction, term = 1.0, 0
     elif config.model == "graded":
-        mesh, zone = graded_plate_mesh(a, config.n_theta, config.n_radial, w, lv,
-                                       config.patch_rings)  # fmt: skip
+        mesh, zone = graded_plate_mesh(coarse, lines, a, lv, cells)
         problem = ZonedPlate(mesh, zone, make_j2, LinearElastic(mesh, elastic, kind))
         plastic, blocks, block, term = problem.j2, ["coarse"], "coarse", 1
         loaded, n_el = problem.elastic, mesh.nelements
         fraction = area(plastic.mesh) / total
     else:
-        k = config.patch_rings
-        plastic = make_j2(refine_projected(coarse, lv, a, cells=np.nonzero(ring < k)[0]))
-        # the gluing band: the patch's outermost coarse ring (its width on the x axis)
-        band = float(radii[k] - radii[k - config.gluing_rings])
-        patch = Patch(plastic, gluing_width=band, coupling=config.coupling,
+        plastic = make_j2(refine_projected(coarse, lv, a, cells=cells))
+        # the gluing band: the patch's outermost layers of coarse cells
+        band = config.gluing_rings * config.coarse_size
+        weights = RampWeights(edge=config.edge_weight)
+        patch = Patch(plastic, gluing_width=band, coupling=config.coupling, weights=weights,
                       overlap_method="nested")  # fmt: skip
         problem = ArlequinProblem(LinearElastic(coarse, elastic, kind), [patch])
         with warnings.catch_warnings(record=True) as caught:
