@@ -16,7 +16,7 @@ MATERIALS = ("small-strain", "finite-strain")
 MAX_LEVELS = 5
 #: The side of the square around the hole that holds its rings, in hole radii.
 BLOCK = 2.0
-#: The default remote traction S (Pa): the plastic zone then reaches about 2.5 hole radii
+#: The default remote traction S (Pa): the plastic zone then reaches about 2.3 hole radii
 #: from the hole's centre (see :mod:`arlequin.demos.plate_with_hole`).
 DEFAULT_LOAD = 195e6
 
@@ -43,11 +43,11 @@ class PlateWithHoleConfig(DemoConfig):
         "A quarter of a plane-strain plate 2W x 2W with a hole of radius A (symmetry on x = 0 "
         "and y = 0) pulled by a uniform traction --load on x = W, loaded to first yield and "
         "then in --steps equal steps solved by Newton with consistent tangents. --model "
-        "arlequin: a coarse linear-elastic model of the plate and a J2 patch of the coarse "
-        "rings around the hole refined --levels times; --model mono: the whole coarse mesh "
-        "refined --levels times, J2 everywhere; --model graded: one conforming mesh, the "
-        "patch's cells around the hole (J2) and the other rings split angularly only "
-        "(elastic). SI units."
+        "arlequin: a coarse linear-elastic model of the plate (rings around the hole in "
+        "[0, 2a]^2, a grid of 2a / n_theta cells beyond) and a J2 patch of the coarse cells in "
+        "[0, RP]^2 refined --levels times; --model mono: the whole coarse mesh refined "
+        "--levels times, J2 everywhere; --model graded: one conforming mesh, the patch's cells "
+        "(J2) and beyond them the grid refined along the patch only (elastic). SI units."
     )
 
     model: str = option("arlequin", "coarse elastic + J2 patch, one fine mesh, or a graded mesh",

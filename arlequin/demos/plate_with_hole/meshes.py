@@ -1,18 +1,25 @@
-"""Meshes of the quarter plate with a hole: graded rings around the hole, in quadrilaterals or
-triangles; the nested refinements with the hole nodes projected onto the circle; the graded
-conforming mesh.
+"""Meshes of the quarter plate with a hole: the quasi-uniform coarse mesh of the demo, the
+polar ring mesh (of ``examples/plate_with_hole.py``, and the demo's rings around the hole), the
+nested refinements with the hole nodes projected onto the circle, the graded conforming mesh.
 
-The quarter plate [0, W]² minus the quarter disc r < a is meshed in polar-like rings: node
-(i, j) lies on the segment from the hole point a (cos θ_j, sin θ_j) to a point of the outer
+:func:`quarter_plate_mesh` meshes [0, W]² minus the quarter disc r < a in polar-like rings:
+node (i, j) lies on the segment from the hole point a (cos θ_j, sin θ_j) to a point of the outer
 edges (x = W for θ ≤ 45°, y = W beyond), at a geometrically graded fraction f_i of its length
-(the first ring about as deep as the hole cells are wide). Ring i = 0 … n_radial − 1 goes
-outwards from the hole. Every hole node lies on the circle.
+(the first ring about as deep as the hole cells are wide). Every ring has the same number of
+cells, so its cells grow with the distance from the hole.
+
+:func:`plate_mesh`, the demo's coarse mesh, uses those rings only in the square [0, 2a]² around
+the hole (their outer edges the square's sides, n_theta cells along each) and meshes the rest of
+the plate with a structured grid of the same lines: cells of 2a / n_theta everywhere away from
+the hole, so that refining the whole mesh (``mono``) is uniformly fine at the patch's
+resolution. The patch is the coarse cells in a square [0, R]² (R a grid line:
+:func:`square_radius`).
 
 :func:`refine_projected` refines (some of) the cells one level at a time, moving the new hole
-nodes radially onto the circle after each level: the Arlequin patch (the first rings), the
-single fine mesh (every ring). :func:`graded_plate_mesh` is one conforming mesh: the patch's
-cells exactly, and beyond them the coarse rings split angularly only (the fine angular
-resolution carried out to the plate's edges, the coarse radial one), so that no node hangs.
+nodes radially onto the circle after each level: the Arlequin patch, the single fine mesh.
+:func:`graded_plate_mesh` is one conforming mesh: the patch's cells exactly, and beyond them
+the tensor grid whose lines are refined below R only (the strips along the patch split in one
+direction, the rest coarse), so that no node hangs.
 
 Sizes in m (any unit: the functions are scale-free).
 """
@@ -28,10 +35,13 @@ from ...coupling.patches import refine_region
 __all__ = [
     "graded_plate_mesh",
     "hole_nodes",
+    "plate_lines",
+    "plate_mesh",
     "project_hole_nodes",
     "quarter_plate_mesh",
     "refine_projected",
     "ring_fractions",
+    "square_radius",
 ]
 
 

@@ -6,14 +6,17 @@ model's edge in the Arlequin run), the hole and y = W are free.
 
 Models:
 
-``arlequin``  a coarse linear-elastic model of the whole plate, and a J2 patch: the first
-              coarse rings (outer edge within ``patch_radius`` on the x axis) refined
-              ``levels`` times, the hole nodes projected onto the circle (nested overlap),
-              glued in its outermost coarse ring (ramp weights, coarse mediator, H1).
-``mono``      the whole coarse mesh refined ``levels`` times, J2 everywhere.
+``arlequin``  a coarse linear-elastic model of the whole plate (the quasi-uniform mesh of
+              :func:`~.meshes.plate_mesh`), and a J2 patch: the coarse cells in the square
+              [0, R]² (R the grid line at or below ``patch_radius``) refined ``levels`` times,
+              the hole nodes projected onto the circle (nested overlap), glued in its
+              outermost layer of coarse cells (ramp weights from ``edge_weight`` on its outer
+              edge, coarse mediator, L2 by default).
+``mono``      the whole coarse mesh refined ``levels`` times, J2 everywhere: uniformly fine at
+              the patch's resolution.
 ``graded``    one conforming mesh (:func:`~.meshes.graded_plate_mesh`): the patch's cells
-              with the J2 model, the other rings split angularly only with the elastic model
-              (one block, two terms, :class:`ZonedPlate`).
+              with the J2 model, the rest a tensor grid refined along the patch only, with the
+              elastic model (one block, two terms, :class:`ZonedPlate`).
 """
 
 from __future__ import annotations
