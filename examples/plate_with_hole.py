@@ -9,8 +9,8 @@ The coarse mesh is structured in polar-like coordinates: node (i, j) lies on the
 hole point a (cos θ_j, sin θ_j) to a point of the outer edges (x = 5a for θ ≤ 45°, y = 5a beyond),
 at a geometrically graded fraction f_i of its length. Cell rings i = 0 … n_radial − 1 go outwards
 from the hole. Every hole node lies on the circle. The mesh functions live in
-:mod:`arlequin.demos.plate_with_hole.meshes` (shared with the elastoplastic demo
-``arlequin plate-with-hole``).
+:mod:`arlequin.demos.plate_with_hole.meshes` (the elastoplastic demo ``arlequin plate-with-hole``
+uses these rings only around its hole, and a quasi-uniform grid beyond).
 
 Two runs at the same resolution near the hole:
 

@@ -9,17 +9,19 @@ consistent tangents (:func:`arlequin.solve_quasi_static`; J2 at small strain wit
 :class:`~arlequin.models.SmallStrainJ2`). Models: see :mod:`.setup`; the page
 ``docs/plate_with_hole.md`` gives the measurements in full.
 
-Defaults (E = 210 GPa, ν = 0.3, σy = 240 MPa, perfectly plastic, a = 10 mm, W = 10a, 16 coarse
-cells along the quarter hole, 24 rings, the patch the 16 rings within 5a refined twice, L2
-coupling): first yield at S = 89.6 MPa; the default S = 195 MPa is where the plastic zone's
-extent from the hole's centre, growing fast as shear bands form, reaches 2.3a (mono: 1.97a at
-190 MPa, 2.69a at 200 MPa). Against ``mono``: the loaded edge's mean displacement within 0.090%
-(``arlequin``) and 0.018% (``graded``) at every state, the final plastic area −1.97% and
-−0.33%. Cost (``benchmarks/plate_with_hole.py``, one process): mono 26.8 s, arlequin 13.9 s,
-graded 13.3 s: T_arlequin / T_graded = 1.04 (target ≤ 1.5, met), T_mono / T_arlequin = 1.93
-(target ≥ 10, not met: every ring of this polar mesh has the same number of cells, so the patch
-holds two thirds of mono's cells); 63% of the Arlequin run is the SuperLU factorisation of the
-patch at each Newton iteration.
+Defaults (E = 210 GPa, ν = 0.3, σy = 240 MPa, perfectly plastic, a = 10 mm, W = 10a; the
+coarse mesh quasi-uniform: 4 rings of 8 cells along the quarter hole in [0, 2a]², a grid of a/2
+cells beyond, 416 cells; the patch the coarse cells of [0, 3.5a]² refined 3 times, 64 fine cells
+along the quarter hole, glued in its outer layer of coarse cells with α_coarse 0.75 on its edge,
+L2 coupling; mono that whole mesh refined 3 times, 26624 cells): first yield at S = 89.6 MPa;
+the default S = 195 MPa is where the plastic zone's extent from the hole's centre, growing fast
+as shear bands form, reaches 2.32a. Against ``mono``: the loaded edge's mean displacement within
+0.143% (``arlequin``) and 0.023% (``graded``) at every state, the final plastic area −1.11% and
+−0.36%, the same extent. Cost (``benchmarks/plate_with_hole.py --repeat 2``, one process, 2
+shared cores): mono 61.7 s, arlequin 5.2 s, graded 9.1 s: T_mono / T_arlequin = 11.8 (target
+≥ 10, met), T_arlequin / T_graded = 0.57 (target ≤ 1.5, met); 51% of the Arlequin run is the
+SuperLU factorisation of its Newton systems (the coarse plate, 880 dofs for the patch's 8496,
+is not condensed: forcing it changes nothing measurable).
 
 Outputs (``out``): results.json (inputs and results with units), ``newton.csv`` (per step:
 load factor, Newton iterations, residuals, cuts), the field series of each block

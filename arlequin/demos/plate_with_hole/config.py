@@ -8,13 +8,15 @@ from typing import Any, ClassVar
 
 from ..config import DemoConfig, check_choice, check_positive, check_range, option
 
-__all__ = ["DEFAULT_LOAD", "MATERIALS", "MAX_LEVELS", "MODELS", "PlateWithHoleConfig"]
+__all__ = ["BLOCK", "DEFAULT_LOAD", "MATERIALS", "MAX_LEVELS", "MODELS", "PlateWithHoleConfig"]
 
 MODELS = ("arlequin", "mono", "graded")
 MATERIALS = ("small-strain", "finite-strain")
 #: More levels than this would make the fine meshes of millions of cells.
 MAX_LEVELS = 5
-#: The default remote traction S (Pa): the plastic zone then reaches about 2.5 hole radii
+#: The side of the square around the hole that holds its rings, in hole radii.
+BLOCK = 2.0
+#: The default remote traction S (Pa): the plastic zone then reaches about 2.3 hole radii
 #: from the hole's centre (see :mod:`arlequin.demos.plate_with_hole`).
 DEFAULT_LOAD = 195e6
 
@@ -41,11 +43,11 @@ class PlateWithHoleConfig(DemoConfig):
         "A quarter of a plane-strain plate 2W x 2W with a hole of radius A (symmetry on x = 0 "
         "and y = 0) pulled by a uniform traction --load on x = W, loaded to first yield and "
         "then in --steps equal steps solved by Newton with consistent tangents. --model "
-        "arlequin: a coarse linear-elastic model of the plate and a J2 patch of the coarse "
-        "rings around the hole refined --levels times; --model mono: the whole coarse mesh "
-        "refined --levels times, J2 everywhere; --model graded: one conforming mesh, the "
-        "patch's cells around the hole (J2) and the other rings split angularly only "
-        "(elastic). SI units."
+        "arlequin: a coarse linear-elastic model of the plate (rings around the hole in "
+        "[0, 2a]^2, a grid of 2a / n_theta cells beyond) and a J2 patch of the coarse cells in "
+        "[0, RP]^2 refined --levels times; --model mono: the whole coarse mesh refined "
+        "--levels times, J2 everywhere; --model graded: one conforming mesh, the patch's cells "
+        "(J2) and beyond them the grid refined along the patch only (elastic). SI units."
     )
 
     model: str = option("arlequin", "coarse elastic + J2 patch, one fine mesh, or a graded mesh",
@@ -55,7 +57,7 @@ class PlateWithHoleConfig(DemoConfig):
     load: float = option(DEFAULT_LOAD, "final remote traction S on x = W", "Pa", metavar="S")
     steps: int = option(10, "equal load steps from first yield to S (cut where Newton needs)",
                         "1", metavar="N")  # fmt: skip
-    levels: int = option(2, "refinement levels of the patch (and of the fine meshes)", "1",
+    levels: int = option(3, "refinement levels of the patch (and of the fine meshes)", "1",
                          metavar="L")  # fmt: skip
     radius: float = option(0.01, "hole radius a", "m", metavar="A")
     half_width: float | None = option(None, "the plate's half width W (>= 10a)", "m",
@@ -65,17 +67,23 @@ class PlateWithHoleConfig(DemoConfig):
     yield_stress: float = option(240e6, "yield stress", "Pa", flag="--yield", metavar="SY")
     hardening: float = option(0.0, "linear isotropic hardening modulus (0: perfectly plastic)",
                               "Pa", metavar="H")  # fmt: skip
-    n_theta: int = option(8, "coarse cells along each 45 degrees of the hole", "1",
+    n_theta: int = option(4, "coarse cells along each 45 degrees of the hole (and along each "
+                          "side of the square [0, 2a]^2 around it: cells of 2a / N beyond)", "1",
                           metavar="N")  # fmt: skip
-    n_radial: int = option(24, "coarse rings from the hole to the edges (geometric)", "1",
-                           metavar="N")  # fmt: skip
-    gluing_rings: int = option(1, "the gluing band: the patch's outermost coarse rings", "1",
-                               metavar="N")  # fmt: skip
+    n_radial: int = option(4, "coarse rings from the hole to the square [0, 2a]^2 (geometric)",
+                           "1", metavar="N")  # fmt: skip
+    gluing_rings: int = option(1, "the gluing band: the patch's outermost coarse cell layers",
+                               "1", metavar="N")  # fmt: skip
+    edge_weight: float = option(
+        0.75, "alpha_coarse on the patch's outer edge, the ramp's start (1: the patch carries "
+        "nothing there and its free edge yields spuriously at the square's corners)", "1",
+        metavar="W0",
+    )  # fmt: skip
     coupling: str = option("L2", "the mediator's coupling (H1 glues the band's gradients too)",
                            "", choices=("L2", "H1"))  # fmt: skip
     patch_radius: float | None = option(
-        None, "the patch: the coarse rings whose outer edge on the x axis is within this "
-        "distance of the centre", "m", metavar="RP", default_help="5a",
+        None, "the patch: the coarse cells within the square [0, RP]^2 (RP snapped down to a "
+        "grid line)", "m", metavar="RP", default_help="3.5a",
     )  # fmt: skip
 
     # -- resolved values ---------------------------------------------------------------------
@@ -86,8 +94,8 @@ class PlateWithHoleConfig(DemoConfig):
 
     @property
     def patch_extent(self) -> float:
-        """The requested patch radius (m) on the x axis."""
-        return 5.0 * self.radius if self.patch_radius is None else self.patch_radius
+        """The requested patch half side (m): the patch holds the coarse cells in [0, RP]²."""
+        return 3.5 * self.radius if self.patch_radius is None else self.patch_radius
 
     # -- checks ------------------------------------------------------------------------------
     def check(self) -> None:
@@ -109,20 +117,17 @@ class PlateWithHoleConfig(DemoConfig):
         check_positive("yield_stress", self.yield_stress, "Pa")
         check_positive("hardening", self.hardening, "Pa", allow_zero=True)
         _count("n_theta", self.n_theta, 1)
-        _count("n_radial", self.n_radial, 3)
+        _count("n_radial", self.n_radial, 1)
         check_positive("patch_radius", self.patch_radius, "m", allow_none=True)
+        check_range("edge_weight", self.edge_weight, 1e-3, 1.0, closed="(]")
+        _count("gluing_rings", self.gluing_rings, 1)
         if self.model != "mono":
-            from .meshes import ring_fractions
-
-            f = ring_fractions(self.radius, self.n_theta, self.n_radial, self.width)
-            radii = self.radius + (self.width - self.radius) * f
-            rings = int((radii[1:] <= self.patch_extent * (1.0 + 1e-12)).sum())
-            _count("gluing_rings", self.gluing_rings, 1)
-            if not self.gluing_rings < rings < self.n_radial:
+            r, h = self.patch_square, self.coarse_size
+            if not self.block + self.gluing_rings * h <= r * (1.0 + 1e-12) < self.width:
                 raise ValueError(
-                    f"patch_radius={self.patch_extent} m must cover more coarse rings than the "
-                    f"gluing band's {self.gluing_rings} (to {radii[self.gluing_rings + 1]:.4g} m) "
-                    f"and leave one outside (below {radii[-2]:.4g} m)"
+                    f"patch_radius={self.patch_extent} m must hold the hole's rings (to "
+                    f"{self.block:.4g} m) and the gluing band's {self.gluing_rings} cell layers "
+                    f"of {h:.4g} m beyond them, and leave cells outside (below {self.width:.4g} m)"
                 )
         if self.material == "finite-strain":
             from ...models import FiniteStrainJ2
@@ -134,13 +139,24 @@ class PlateWithHoleConfig(DemoConfig):
                 )
 
     @property
-    def patch_rings(self) -> int:
-        """The coarse rings of the patch (or of the graded mesh's fine zone)."""
-        from .meshes import ring_fractions
+    def block(self) -> float:
+        """The side (m) of the square [0, block]² holding the rings around the hole: 2a."""
+        return BLOCK * self.radius
 
-        f = ring_fractions(self.radius, self.n_theta, self.n_radial, self.width)
-        radii = self.radius + (self.width - self.radius) * f
-        return int((radii[1:] <= self.patch_extent * (1.0 + 1e-12)).sum())
+    @property
+    def coarse_size(self) -> float:
+        """The coarse cells' size (m) away from the hole: block / n_theta."""
+        return self.block / self.n_theta
+
+    @property
+    def patch_square(self) -> float:
+        """The patch's half side R (m): the largest grid line within ``patch_extent`` (the
+        patch is the coarse cells in [0, R]², the hole's rings included)."""
+        from .meshes import plate_lines
+
+        lines = plate_lines(self.radius, self.n_theta, self.width, self.block)
+        inside = lines[lines <= self.patch_extent * (1.0 + 1e-12)]
+        return float(inside[-1])
 
     def progress_scale(self) -> tuple[float, str, float, str]:
         return 100.0, "%", 100.0, f"{self.command} ({self.model})"

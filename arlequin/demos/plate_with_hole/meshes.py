@@ -1,18 +1,25 @@
-"""Meshes of the quarter plate with a hole: graded rings around the hole, in quadrilaterals or
-triangles; the nested refinements with the hole nodes projected onto the circle; the graded
-conforming mesh.
+"""Meshes of the quarter plate with a hole: the quasi-uniform coarse mesh of the demo, the
+polar ring mesh (of ``examples/plate_with_hole.py``, and the demo's rings around the hole), the
+nested refinements with the hole nodes projected onto the circle, the graded conforming mesh.
 
-The quarter plate [0, W]² minus the quarter disc r < a is meshed in polar-like rings: node
-(i, j) lies on the segment from the hole point a (cos θ_j, sin θ_j) to a point of the outer
+:func:`quarter_plate_mesh` meshes [0, W]² minus the quarter disc r < a in polar-like rings:
+node (i, j) lies on the segment from the hole point a (cos θ_j, sin θ_j) to a point of the outer
 edges (x = W for θ ≤ 45°, y = W beyond), at a geometrically graded fraction f_i of its length
-(the first ring about as deep as the hole cells are wide). Ring i = 0 … n_radial − 1 goes
-outwards from the hole. Every hole node lies on the circle.
+(the first ring about as deep as the hole cells are wide). Every ring has the same number of
+cells, so its cells grow with the distance from the hole.
+
+:func:`plate_mesh`, the demo's coarse mesh, uses those rings only in the square [0, 2a]² around
+the hole (their outer edges the square's sides, n_theta cells along each) and meshes the rest of
+the plate with a structured grid of the same lines: cells of 2a / n_theta everywhere away from
+the hole, so that refining the whole mesh (``mono``) is uniformly fine at the patch's
+resolution. The patch is the coarse cells in a square [0, R]² (R a grid line:
+:func:`square_radius`).
 
 :func:`refine_projected` refines (some of) the cells one level at a time, moving the new hole
-nodes radially onto the circle after each level: the Arlequin patch (the first rings), the
-single fine mesh (every ring). :func:`graded_plate_mesh` is one conforming mesh: the patch's
-cells exactly, and beyond them the coarse rings split angularly only (the fine angular
-resolution carried out to the plate's edges, the coarse radial one), so that no node hangs.
+nodes radially onto the circle after each level: the Arlequin patch, the single fine mesh.
+:func:`graded_plate_mesh` is one conforming mesh: the patch's cells exactly, and beyond them
+the tensor grid whose lines are refined below R only (the strips along the patch split in one
+direction, the rest coarse), so that no node hangs.
 
 Sizes in m (any unit: the functions are scale-free).
 """
@@ -28,10 +35,13 @@ from ...coupling.patches import refine_region
 __all__ = [
     "graded_plate_mesh",
     "hole_nodes",
+    "plate_lines",
+    "plate_mesh",
     "project_hole_nodes",
     "quarter_plate_mesh",
     "refine_projected",
     "ring_fractions",
+    "square_radius",
 ]
 
 
@@ -180,35 +190,88 @@ def refine_projected(
     return out
 
 
-def graded_plate_mesh(
-    a: float, n_theta: int, n_radial: int, half_width: float, levels: int, n_fine_rings: int
+def _merge(first: skfem.MeshQuad, second: skfem.MeshQuad, scale: float) -> skfem.MeshQuad:
+    """One mesh of the cells of ``first`` then those of ``second``, the nodes of ``second`` that
+    coincide with nodes of ``first`` (to 1e-9 ``scale``) merged into them."""
+    dist, match = cKDTree(first.p.T).query(second.p.T)
+    shared = dist <= 1e-9 * scale
+    index = np.empty(second.nvertices, dtype=np.int64)
+    index[shared] = match[shared]
+    index[~shared] = first.nvertices + np.arange(np.count_nonzero(~shared))
+    p = np.hstack([first.p, second.p[:, ~shared]])
+    return skfem.MeshQuad(p, np.hstack([first.t, index[second.t]]))
+
+
+def _outside(lines: np.ndarray, inner: float) -> skfem.MeshQuad:
+    """The tensor grid of ``lines`` × ``lines`` without its cells inside [0, inner]²."""
+    grid = skfem.MeshQuad.init_tensor(lines, lines)
+    centre = grid.p[:, grid.t].mean(axis=1)
+    return grid.restrict(np.nonzero(centre.max(axis=0) > inner)[0])
+
+
+def plate_lines(a: float, n_theta: int, half_width: float, block: float) -> np.ndarray:
+    """The grid lines (m, the same in x and y) of the quasi-uniform part of the plate: ``n_theta``
+    equal cells across the hole's block [0, block], then cells of about the same size
+    (block / n_theta) out to W."""
+    h = block / n_theta
+    k = max(1, int(np.ceil((half_width - block) / h - 1e-9)))
+    return np.concatenate([np.linspace(0.0, block, n_theta + 1),
+                           np.linspace(block, half_width, k + 1)[1:]])  # fmt: skip
+
+
+def plate_mesh(
+    a: float, n_theta: int, n_rings: int, half_width: float, block: float
 ) -> tuple[skfem.MeshQuad, np.ndarray]:
-    """One conforming quadrilateral mesh: the first ``n_fine_rings`` coarse rings refined
-    ``levels`` times (exactly the cells of the nested patch, :func:`refine_projected`), and the
-    other rings split angularly only (2^levels cells for each coarse one), out to the edges.
+    """The quasi-uniform coarse mesh of the quarter plate [0, W]² minus the quarter disc r < a.
+
+    The square [0, block]² around the hole holds the rings of :func:`quarter_plate_mesh` (its
+    ``half_width`` = ``block``: 2 ``n_theta`` cells along the quarter hole, ``n_rings`` rings
+    blending the circle into the square's sides, ``n_theta`` cells along each), and the rest of
+    the plate a structured grid of the same lines (:func:`plate_lines`): cells of size
+    block / n_theta everywhere away from the hole, conforming with the rings.
+
+    Returns
+    -------
+    mesh : skfem.MeshQuad
+        The ring cells first.
+    lines : ndarray
+        The grid lines (m).
+    """
+    rings, _, _ = quarter_plate_mesh(a, n_theta, n_rings, "quad", block)
+    lines = plate_lines(a, n_theta, half_width, block)
+    return _merge(rings, _outside(lines, block), half_width), lines
+
+
+def square_radius(mesh: skfem.Mesh) -> np.ndarray:
+    """Each cell's largest max(x, y) over its vertices (m): the cells with square_radius ≤ R
+    tile [0, R]² minus the hole (R a grid line)."""
+    return mesh.p[:, mesh.t].max(axis=(0, 1))
+
+
+def graded_plate_mesh(
+    coarse: skfem.MeshQuad, lines: np.ndarray, a: float, levels: int, patch: np.ndarray
+) -> tuple[skfem.MeshQuad, np.ndarray]:
+    """One conforming quadrilateral mesh: the ``patch`` cells of the coarse mesh refined
+    ``levels`` times (exactly the nested patch, :func:`refine_projected`), which must tile
+    [0, R]² minus the hole (R a grid line), and the tensor grid outside it whose lines are the
+    coarse ones refined 2^levels times below R, the coarse ones beyond: the strips beside the
+    patch split along it only, the rest coarse, no node hanging.
 
     Returns
     -------
     mesh : skfem.MeshQuad
     fine : ndarray of int
-        The cells of the refined rings (the patch region), the first ones of the mesh.
+        The cells of the refined region (the patch's), the first ones of the mesh.
     """
-    coarse, ring, _ = quarter_plate_mesh(a, n_theta, n_radial, "quad", half_width)
-    fine = refine_projected(coarse, levels, a, cells=np.nonzero(ring < n_fine_rings)[0])
-    if n_fine_rings >= n_radial:
-        return fine, np.arange(fine.nelements)
+    fine = refine_projected(coarse, levels, a, cells=patch)
+    r = float(square_radius(coarse)[patch].max())
+    inner = lines[lines <= r * (1.0 + 1e-12)]
     split = 2**levels
-    inner, outer = _end_points(a, n_theta, half_width, split)
-    f = ring_fractions(a, n_theta, n_radial, half_width)[n_fine_rings:]
-    p = (inner[:, None, :] + f[None, :, None] * (outer - inner)[:, None, :]).reshape(2, -1)
-    n_ang = 2 * n_theta * split
-    outside, _ = _structured(p, f.size - 1, n_ang, "quad")
-    # the first row of the outside grid is the refined rings' outer boundary: merge its nodes
-    tree = cKDTree(fine.p.T)
-    dist, match = tree.query(outside.p[:, : n_ang + 1].T)
-    if dist.max() > 1e-9 * half_width:
-        raise RuntimeError(f"graded mesh: the rings do not meet (gap {dist.max():.3g})")
-    index = np.concatenate([match, fine.nvertices + np.arange(outside.nvertices - n_ang - 1)])
-    p_all = np.hstack([fine.p, outside.p[:, n_ang + 1 :]])
-    t_all = np.hstack([fine.t, index[outside.t]])
-    return skfem.MeshQuad(p_all, t_all), np.arange(fine.nelements)
+    s = np.linspace(0.0, inner.size - 1, (inner.size - 1) * split + 1)
+    j = np.minimum(np.floor(s).astype(int), inner.size - 2)
+    fine_lines = inner[j] + (s - j) * (inner[j + 1] - inner[j])
+    all_lines = np.concatenate([fine_lines, lines[lines > r * (1.0 + 1e-12)]])
+    if all_lines.size == fine_lines.size:
+        return fine, np.arange(fine.nelements)
+    mesh = _merge(fine, _outside(all_lines, r), float(lines[-1]))
+    return mesh, np.arange(fine.nelements)

@@ -6,14 +6,17 @@ model's edge in the Arlequin run), the hole and y = W are free.
 
 Models:
 
-``arlequin``  a coarse linear-elastic model of the whole plate, and a J2 patch: the first
-              coarse rings (outer edge within ``patch_radius`` on the x axis) refined
-              ``levels`` times, the hole nodes projected onto the circle (nested overlap),
-              glued in its outermost coarse ring (ramp weights, coarse mediator, H1).
-``mono``      the whole coarse mesh refined ``levels`` times, J2 everywhere.
+``arlequin``  a coarse linear-elastic model of the whole plate (the quasi-uniform mesh of
+              :func:`~.meshes.plate_mesh`), and a J2 patch: the coarse cells in the square
+              [0, R]² (R the grid line at or below ``patch_radius``) refined ``levels`` times,
+              the hole nodes projected onto the circle (nested overlap), glued in its
+              outermost layer of coarse cells (ramp weights from ``edge_weight`` on its outer
+              edge, coarse mediator, L2 by default).
+``mono``      the whole coarse mesh refined ``levels`` times, J2 everywhere: uniformly fine at
+              the patch's resolution.
 ``graded``    one conforming mesh (:func:`~.meshes.graded_plate_mesh`): the patch's cells
-              with the J2 model, the other rings split angularly only with the elastic model
-              (one block, two terms, :class:`ZonedPlate`).
+              with the J2 model, the rest a tensor grid refined along the patch only, with the
+              elastic model (one block, two terms, :class:`ZonedPlate`).
 """
 
 from __future__ import annotations
@@ -29,10 +32,11 @@ import skfem
 
 from ...coupling.exactness import ExactnessWarning
 from ...coupling.gluing import Patch
+from ...coupling.weights import RampWeights
 from ...models import IsotropicElastic, J2Material, LinearElastic
 from ...problem.arlequin_problem import ArlequinProblem
 from ...problem.system import Block, BlockTerm, CoupledSystem
-from .meshes import graded_plate_mesh, quarter_plate_mesh, refine_projected
+from .meshes import graded_plate_mesh, plate_mesh, refine_projected, square_radius
 
 if TYPE_CHECKING:  # annotations only: the configuration runs this module
     from .config import PlateWithHoleConfig
@@ -188,7 +192,8 @@ def area(mesh: Any) -> float:
 def build(config: PlateWithHoleConfig) -> PlateSetup:
     """The problem of ``config`` (supports, and the traction at λ = 1: the final load S)."""
     a, w, lv = config.radius, config.width, config.levels
-    coarse, ring, radii = quarter_plate_mesh(a, config.n_theta, config.n_radial, "quad", w)
+    coarse, lines = plate_mesh(a, config.n_theta, config.n_radial, w, config.block)
+    cells = np.nonzero(square_radius(coarse) <= config.patch_square * (1.0 + 1e-12))[0]
     make_j2 = j2_factory(config)
     elastic = IsotropicElastic(config.young, config.poisson, DENSITY)
     kind = "plane_strain"
@@ -200,18 +205,17 @@ def build(config: PlateWithHoleConfig) -> PlateSetup:
         blocks, block, loaded, n_el = ["coarse"], "coarse", plastic, plastic.mesh.nelements
         fraction, term = 1.0, 0
     elif config.model == "graded":
-        mesh, zone = graded_plate_mesh(a, config.n_theta, config.n_radial, w, lv,
-                                       config.patch_rings)  # fmt: skip
+        mesh, zone = graded_plate_mesh(coarse, lines, a, lv, cells)
         problem = ZonedPlate(mesh, zone, make_j2, LinearElastic(mesh, elastic, kind))
         plastic, blocks, block, term = problem.j2, ["coarse"], "coarse", 1
         loaded, n_el = problem.elastic, mesh.nelements
         fraction = area(plastic.mesh) / total
     else:
-        k = config.patch_rings
-        plastic = make_j2(refine_projected(coarse, lv, a, cells=np.nonzero(ring < k)[0]))
-        # the gluing band: the patch's outermost coarse ring (its width on the x axis)
-        band = float(radii[k] - radii[k - config.gluing_rings])
-        patch = Patch(plastic, gluing_width=band, coupling=config.coupling,
+        plastic = make_j2(refine_projected(coarse, lv, a, cells=cells))
+        # the gluing band: the patch's outermost layers of coarse cells
+        band = config.gluing_rings * config.coarse_size
+        weights = RampWeights(edge=config.edge_weight)
+        patch = Patch(plastic, gluing_width=band, coupling=config.coupling, weights=weights,
                       overlap_method="nested")  # fmt: skip
         problem = ArlequinProblem(LinearElastic(coarse, elastic, kind), [patch])
         with warnings.catch_warnings(record=True) as caught:
