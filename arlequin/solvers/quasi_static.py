@@ -41,6 +41,7 @@ import numpy as np
 
 from ..contract import SimulationError, StateError
 from ..problem.system import CoupledSystem
+from .adaptive import run_adaptive
 from .condensation import SaddleSolver
 from .constraints import is_unilateral
 from .operators import SystemOperators, as_system, as_vector
@@ -132,6 +133,12 @@ class QuasiStaticResult:
     states: dict[str, list[Any]]
     limit_load: float | None = None
     system: CoupledSystem | None = field(default=None, repr=False)
+    #: with ``adapt=``: the patch's growths (:class:`arlequin.problem.adapt.Adaptation`), the
+    #: largest σ_vm/σy of the coarse model outside the patch over the accepted steps, the
+    #: final problem
+    adaptations: list[Any] = field(default_factory=list)
+    max_coarse_yield_ratio: float | None = None
+    problem: Any = field(default=None, repr=False)
 
     @property
     def newton_iterations(self) -> list[int]:
@@ -225,6 +232,7 @@ class QuasiStaticSolver:
         self.max_backtracks = int(max_backtracks)
         self.ops = SystemOperators(self.system, lumped=False)
         self.ops.check_tangents("the quasi-static solver")
+        self.condense = bool(condense)
         self.saddle = SaddleSolver(self.system, self.ops, condense=condense)
         self.t = self.t0
         self.u = as_vector(u0, self.system, "u0")
@@ -415,6 +423,51 @@ class QuasiStaticSolver:
             time=self.t + dt,
         )
 
+    # -- adaptation (arlequin.problem.adapt, driven by arlequin.solvers.adaptive) ------------
+    _SNAPSHOT = ("u", "mu", "states", "t", "dt", "status", "_previous", "_first_stiffness",
+                 "_last_stiffness")  # fmt: skip
+
+    def snapshot(self) -> dict[str, Any]:
+        """The committed state (to compute a step again, :meth:`restore`)."""
+        return {"history": len(self.history), **{k: getattr(self, k) for k in self._SNAPSHOT}}
+
+    def restore(self, snap: dict[str, Any]) -> None:
+        """Back to a :meth:`snapshot` (the steps committed since forgotten)."""
+        del self.history[snap["history"] :]
+        for k in self._SNAPSHOT:
+            setattr(self, k, snap[k])
+
+    def replace_system(self, system: Any, u: np.ndarray, states: dict[str, list[Any]]) -> None:
+        """Go on with another system (a grown patch) from the fields ``u`` and ``states`` moved
+        onto it at the same load factor (blocks missing from ``states``: initial states); the
+        multipliers are zero until :meth:`resolve`."""
+        self.system = as_system(system)
+        self.ops = SystemOperators(self.system, lumped=False)
+        self.ops.check_tangents("the quasi-static solver")
+        self.saddle = SaddleSolver(self.system, self.ops, condense=self.condense)
+        self.u = as_vector(u, self.system, "u")
+        self.states = {**self.ops.initial_states(), **states}
+        self.mu = np.zeros(self.saddle.n_multipliers)
+        self._previous = None
+
+    def resolve(self) -> int:
+        """Newton at the committed load factor from the committed fields (after
+        :meth:`replace_system`): commits u, μ and the states; returns the iterations."""
+        try:
+            u, mu, trial, history = self._newton(self.t)
+        except _StepFailed as fail:
+            raise NewtonError(f"re-solving the grown patch at λ = {self.t:.6g} failed: {fail}",
+                              step=len(self.history), time=self.t) from fail  # fmt: skip
+        self.u, self.mu, self.states = u, mu, trial
+        return len(history) - 1
+
+    def stored_energy(self) -> float:
+        """The total stored energy (J) of the committed fields: ½ uᵀK u of the linear blocks
+        and the nonlinear blocks' ``stored_energy_of_state`` (their internal work otherwise)."""
+        zero = np.zeros(len(self.system.blocks))
+        stored, _ = self.ops.stored_and_dissipated(self.states, zero)
+        return float(self.ops.strain_linear(self.u).sum() + stored.sum())
+
     # -- results -----------------------------------------------------------------------------
     def reactions(self) -> np.ndarray:
         """Reaction forces (N) at the Dirichlet dofs, zero elsewhere."""
@@ -463,6 +516,7 @@ def solve_quasi_static(
     steps: int = 10,
     on_step: Sequence[Callable[[QuasiStaticSolver], Any]] = (),
     callback: Callable[[QuasiStaticSolver], bool] | None = None,
+    adapt: Any = None,
     **options: Any,
 ) -> QuasiStaticResult:
     """Solve a quasi-static problem by load stepping and Newton (see the module docstring).
@@ -479,6 +533,10 @@ def solve_quasi_static(
         ``solver.states``, ``solver.history[-1]``): to write results as the run goes.
     callback : callable, optional
         Called likewise; returning True stops the run (status ``"stopped"``).
+    adapt : AdaptivePatch, optional
+        A patch that grows where the material yields (:mod:`arlequin.problem.adapt`, driven by
+        :func:`arlequin.solvers.adaptive.run_adaptive`); listeners with an ``on_adapt(solver,
+        adapt)`` member are told of each growth.
     **options
         Passed to :class:`QuasiStaticSolver` (``proportional``, ``tol``, ``max_iterations``,
         ``min_step``, ``growth``, ``line_search``, ``condense``, ``reference_time``, ``t0``,
@@ -498,7 +556,11 @@ def solve_quasi_static(
     ValueError
         Bad input (named), before any work.
     """
+    if adapt is not None:
+        problem = adapt.bind(problem)
     solver = QuasiStaticSolver(problem, load=load, steps=steps, **options)
+    if adapt is not None:
+        return run_adaptive(solver, adapt, on_step, callback)
     while solver.status == "running":
         try:
             rec = solver.step()
