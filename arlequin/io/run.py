@@ -128,6 +128,7 @@ class QuasiStaticRunWriter:
     def __init__(self, folder: ResultsFolder, system: Any, layout: FieldLayout,
                  cell_data: Any = None, units: dict[str, str] | None = None) -> None:  # fmt: skip
         self.system, self.layout, self.cell_data = system, layout, cell_data
+        self._folder = folder
         self.history = folder.history(
             self.columns,
             {
@@ -141,7 +142,19 @@ class QuasiStaticRunWriter:
             name="newton",
         )
         self.series = {bf.name: folder.series(bf.name, bf.mesh) for bf in layout.blocks}
+        self._meshes = {bf.name: bf.mesh for bf in layout.blocks}
         folder.meta.setdefault("field_units", {}).update({**layout.units, **(units or {})})
+
+    def on_adapt(self, solver: Any, adapt: Any) -> None:
+        """A patch grew (``solve_quasi_static(..., adapt=)``): the next frames go on the new
+        system, the blocks whose mesh changed into a new series ``fields/NAME_K.xdmf`` (K the
+        growths so far: a meshio XDMF time series holds one mesh)."""
+        self.system, self.layout = solver.system, adapt.problem.field_layout()
+        self._growths = getattr(self, "_growths", 0) + 1
+        for bf in self.layout.blocks:
+            if bf.mesh is not self._meshes[bf.name]:
+                self.series[bf.name] = self._folder.series(f"{bf.name}_{self._growths}", bf.mesh)
+                self._meshes[bf.name] = bf.mesh
 
     def __call__(self, solver: Any) -> None:
         rec = solver.history[-1]

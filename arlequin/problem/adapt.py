@@ -224,6 +224,15 @@ class AdaptivePatch:
         ``indicator(view: AdaptView) -> (n_coarse_cells,) bool``, replacing the default.
     patch : int
         Which patch of the problem adapts.
+    reject_band_plasticity : bool
+        A step after which plastic flow reached the gluing band (where the weights let the
+        patch's fine modes yield almost freely, ε̄p meaningless once the band moves on) is not
+        accepted either, when the patch can grow there: computed again after the growth.
+    closure : callable, optional
+        ``closure(mask) -> mask``: the coarse cells of the grown patch (boolean, one per coarse
+        cell) completed to a shape the problem keeps (the pressure vessel: whole rings, so that
+        the gluing band stays a ring: bands with corners do not reproduce a uniform stress with
+        a coarse mediator and let the fine modes there yield spuriously). It may only add cells.
     """
 
     def __init__(
@@ -238,6 +247,8 @@ class AdaptivePatch:
         max_fraction: float = 0.9,
         indicator: Callable[[AdaptView], np.ndarray] | None = None,
         patch: int = 0,
+        reject_band_plasticity: bool = True,
+        closure: Callable[[np.ndarray], np.ndarray] | None = None,
     ) -> None:
         if not (isinstance(threshold, (int, float)) and 0.0 < threshold <= 1.0):
             raise ValueError(f"threshold β must lie in (0, 1], got threshold={threshold!r}")
@@ -254,7 +265,10 @@ class AdaptivePatch:
         self.model_factory, self.levels, self.refine = model_factory, levels, refine
         self.threshold, self.buffer, self.band_cells = float(threshold), int(buffer), band_cells
         self.every, self.max_fraction, self.indicator = int(every), float(max_fraction), indicator
-        self.index = int(patch)
+        self.index, self.reject_band_plasticity = int(patch), bool(reject_band_plasticity)
+        if closure is not None and not callable(closure):
+            raise ValueError(f"closure must be callable, got {type(closure).__name__}")
+        self.closure = closure
         self.records: list[Adaptation] = []
         self.max_coarse_yield_ratio = 0.0
         self.problem: ArlequinProblem | None = None
@@ -339,24 +353,33 @@ class AdaptivePatch:
         outside[self.cells] = False
         ratio = view.coarse_von_mises / view.yield_stress
         worst = float(ratio[outside].max()) if outside.any() else 0.0
-        reject = worst > 1.0
+        band_flags, in_band = self._band_flags(view, outside)
+        reject = worst > 1.0 or (in_band and self.reject_band_plasticity and band_flags.any())
         if not reject:
             self.max_coarse_yield_ratio = max(self.max_coarse_yield_ratio, worst)
             if step % self.every:
                 return None
-        flags = self._flags(view, ratio, outside)
+        flags = self._flags(view, ratio, outside, band_flags)
         if reject:
-            flags = flags | (ratio > 1.0)
+            flags = flags | (ratio > 1.0) | band_flags
         flags &= outside
         if not flags.any():
             return None
         grown = _rings(self.problem.coarse.mesh, flags, self.buffer) | ~outside
+        if self.closure is not None:
+            closed = np.asarray(self.closure(grown.copy()), dtype=bool)
+            if closed.shape != grown.shape or np.any(grown & ~closed):
+                raise IndicatorError(f"closure must return a mask of shape {grown.shape} that "
+                                     "keeps every cell it was given")  # fmt: skip
+            grown = closed
         if reject:
-            msg = "step %d: the coarse model yields outside %s (σ_vm/σy = %.4g): the patch grows"
-            logger.info(msg + " and the step is computed again", step, self.name, worst)
+            msg = "step %d: %s (coarse σ_vm/σy = %.4g outside %s): the patch grows and the step"
+            why = "plastic flow in the gluing band" if worst <= 1.0 else "the coarse model yields"
+            logger.info(msg + " is computed again", step, why, worst, self.name)
         return Growth(np.nonzero(grown)[0], reject)
 
-    def _flags(self, view: AdaptView, ratio: np.ndarray, outside: np.ndarray) -> np.ndarray:
+    def _flags(self, view: AdaptView, ratio: np.ndarray, outside: np.ndarray,
+               band_flags: np.ndarray) -> np.ndarray:  # fmt: skip
         n = outside.size
         if self.indicator is not None:
             flags = np.asarray(self.indicator(view))
@@ -364,12 +387,12 @@ class AdaptivePatch:
                 raise IndicatorError(f"the indicator must return one flag per coarse cell, shape "
                                      f"({n},), got shape {flags.shape}")  # fmt: skip
             return flags.astype(bool)
-        flags = outside & (ratio >= self.threshold)
-        return flags | self._band_flags(view, outside)
+        return (outside & (ratio >= self.threshold)) | band_flags
 
-    def _band_flags(self, view: AdaptView, outside: np.ndarray) -> np.ndarray:
+    def _band_flags(self, view: AdaptView, outside: np.ndarray) -> tuple[np.ndarray, bool]:
         """The coarse cells outside the patch next to the parents of the plastic fine cells
-        within ``band_cells`` fine cells of the gluing band."""
+        within ``band_cells`` fine cells of the gluing band, and whether plastic flow reached
+        the band itself."""
         pc = self.problem.couplings[self.index]
         model = pc.fine_model
         eqps = getattr(model, "equivalent_plastic_strain", None)
@@ -377,14 +400,21 @@ class AdaptivePatch:
         fmesh = model.mesh
         band = np.zeros(fmesh.nelements, dtype=bool)
         band[pc.fine_gluing_cells] = True
-        near = _rings(fmesh, band, self.band_cells) & (ep.max(axis=1) > 0.0)
+        plastic = ep.max(axis=1) > 0.0
+        near = _rings(fmesh, band, self.band_cells) & plastic
         if not near.any():
-            return np.zeros(outside.size, dtype=bool)
+            return np.zeros(outside.size, dtype=bool), False
         parent = np.empty(fmesh.nelements, dtype=np.int64)
         parent[pc.overlap.fine_cells] = pc.overlap.coarse_cells
         touched = np.zeros(outside.size, dtype=bool)
         touched[parent[near]] = True
-        return _rings(self.problem.coarse.mesh, touched, 1) & outside
+        # the nearest cells outside: the parents' rings out to the patch's boundary
+        cmesh = self.problem.coarse.mesh
+        for _ in range(2 + self.band_cells // 2**self.levels):
+            touched = _rings(cmesh, touched, 1)
+            if (touched & outside).any():
+                break
+        return touched & outside, bool(plastic[band].any())
 
     # -- growing -----------------------------------------------------------------------------
     def grow(self, growth: Growth, u: np.ndarray, states: dict[str, list[Any]], step: int,
@@ -420,6 +450,7 @@ class AdaptivePatch:
             new.couplings  # noqa: B018
         for w in caught:
             logger.info("%s", w.message)
+        self._last = (old, new)
         u_new = self._transfer_u(old, new, u)
         state = self._transfer_state(old_pc, new.couplings[self.index], states[self.name][0])
         self.problem, self.cells = new, cells
@@ -429,6 +460,11 @@ class AdaptivePatch:
         logger.info("step %d: %s grew to %d coarse cells (%d fine, %.3f of the mesh)", step,
                     self.name, cells.size, model.mesh.nelements, fraction)  # fmt: skip
         return new, u_new, {self.name: [state]}
+
+    def transfer_displacement(self, u: np.ndarray) -> np.ndarray:
+        """A displacement of the problem before the last growth moved onto the grown one (as
+        :meth:`grow` moves the committed one)."""
+        return self._transfer_u(*self._last, u)
 
     def _transfer_u(self, old: ArlequinProblem, new: ArlequinProblem, u: np.ndarray) -> np.ndarray:
         old_map, new_map = old.dofmap(), new.dofmap()

@@ -17,18 +17,70 @@ import logging
 from collections.abc import Callable, Sequence
 from typing import Any
 
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
 from ..contract import SimulationError
 
-__all__ = ["run_adaptive"]
+__all__ = ["AdaptableSolver", "run_adaptive"]
 
 logger = logging.getLogger(__name__)
 
 
+class AdaptableSolver:
+    """What :func:`run_adaptive` needs of a quasi-static solver besides ``replace_system``
+    and ``resolve``: to undo a step, the least-squares multipliers of moved fields, the
+    stored energy (a mixin of :class:`~arlequin.solvers.quasi_static.QuasiStaticSolver`)."""
+
+    _SNAPSHOT = ("u", "mu", "states", "t", "dt", "status", "_previous", "_first_stiffness",
+                 "_last_stiffness")  # fmt: skip
+
+    def snapshot(self) -> dict[str, Any]:
+        """The committed state (to compute a step again, :meth:`restore`)."""
+        return {"history": len(self.history), **{k: getattr(self, k) for k in self._SNAPSHOT}}
+
+    def restore(self, snap: dict[str, Any]) -> None:
+        """Back to a :meth:`snapshot` (the steps committed since forgotten)."""
+        del self.history[snap["history"] :]
+        for k in self._SNAPSHOT:
+            setattr(self, k, snap[k])
+
+    def _least_squares_multipliers(self) -> np.ndarray:
+        """The multipliers that best balance the committed fields, min ‖r + Bᵀμ‖ on the free
+        dofs: Newton starting from μ = 0 after a growth sees the whole coupling force as
+        residual (and diverges from the elastic tangent of the yielding points)."""
+        if not self.saddle.n_multipliers:
+            return self.mu
+        f_int, _, _ = self.ops.internal_force(self.u, self.states)
+        r_free = self._residual_of(f_int, self.u, np.zeros_like(self.mu), self.t)[0]
+        bf = self.saddle.b[:, self.saddle.free].tocsr()
+        gram = (bf @ bf.T).tocsc()
+        shift = 1e-12 * float(np.abs(gram.diagonal()).max())
+        gram = gram + shift * sp.identity(gram.shape[0], format="csc")
+        return spla.splu(gram).solve(-(bf @ r_free))
+
+    def stored_energy(self) -> float:
+        """The total stored energy (J) of the committed fields: ½ uᵀK u of the linear blocks
+        and the nonlinear blocks' ``stored_energy_of_state`` (their internal work otherwise)."""
+        zero = np.zeros(len(self.system.blocks))
+        stored, _ = self.ops.stored_and_dissipated(self.states, zero)
+        return float(self.ops.strain_linear(self.u).sum() + stored.sum())
+
+    @property
+    def previous(self) -> tuple[np.ndarray, float] | None:
+        """The displacement and load factor of the step before the committed one, if any."""
+        return None if self._previous is None else (self._previous[0], self._previous[2])
+
+
 def _grow(solver: Any, adapt: Any, growth: Any, step: int, listeners: Sequence[Any]) -> None:
     before = solver.stored_energy()
+    previous = solver.previous
     problem, u, states = adapt.grow(growth, solver.u, solver.states, step, solver.t)
+    if previous is not None:  # the next step's predictor: the last increment, moved too
+        previous = (adapt.transfer_displacement(previous[0]), previous[1])
     solver.replace_system(problem, u, states)
-    iterations = solver.resolve()
+    iterations = solver.resolve(previous)
     after = solver.stored_energy()
     record = adapt.records[-1]
     record.newton_iterations = iterations

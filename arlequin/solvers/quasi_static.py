@@ -41,7 +41,7 @@ import numpy as np
 
 from ..contract import SimulationError, StateError
 from ..problem.system import CoupledSystem
-from .adaptive import run_adaptive
+from .adaptive import AdaptableSolver, run_adaptive
 from .condensation import SaddleSolver
 from .constraints import is_unilateral
 from .operators import SystemOperators, as_system, as_vector
@@ -159,7 +159,7 @@ class _StepFailed(Exception):
         self.kind = kind  # "newton", "state", "singular"
 
 
-class QuasiStaticSolver:
+class QuasiStaticSolver(AdaptableSolver):
     """Load stepping with Newton on a coupled system (see the module docstring).
 
     Parameters
@@ -424,19 +424,6 @@ class QuasiStaticSolver:
         )
 
     # -- adaptation (arlequin.problem.adapt, driven by arlequin.solvers.adaptive) ------------
-    _SNAPSHOT = ("u", "mu", "states", "t", "dt", "status", "_previous", "_first_stiffness",
-                 "_last_stiffness")  # fmt: skip
-
-    def snapshot(self) -> dict[str, Any]:
-        """The committed state (to compute a step again, :meth:`restore`)."""
-        return {"history": len(self.history), **{k: getattr(self, k) for k in self._SNAPSHOT}}
-
-    def restore(self, snap: dict[str, Any]) -> None:
-        """Back to a :meth:`snapshot` (the steps committed since forgotten)."""
-        del self.history[snap["history"] :]
-        for k in self._SNAPSHOT:
-            setattr(self, k, snap[k])
-
     def replace_system(self, system: Any, u: np.ndarray, states: dict[str, list[Any]]) -> None:
         """Go on with another system (a grown patch) from the fields ``u`` and ``states`` moved
         onto it at the same load factor (blocks missing from ``states``: initial states); the
@@ -450,23 +437,22 @@ class QuasiStaticSolver:
         self.mu = np.zeros(self.saddle.n_multipliers)
         self._previous = None
 
-    def resolve(self) -> int:
+    def resolve(self, previous: tuple[np.ndarray, float] | None = None) -> int:
         """Newton at the committed load factor from the committed fields (after
-        :meth:`replace_system`): commits u, μ and the states; returns the iterations."""
+        :meth:`replace_system`): commits u, μ and the states; returns the iterations.
+        ``previous``: the displacement of the step before (moved onto the new system) and its
+        load factor, for the next step's predictor (without it the next step starts from the
+        committed fields, as the first step)."""
+        self.mu = self._least_squares_multipliers()
         try:
             u, mu, trial, history = self._newton(self.t)
         except _StepFailed as fail:
             raise NewtonError(f"re-solving the grown patch at λ = {self.t:.6g} failed: {fail}",
                               step=len(self.history), time=self.t) from fail  # fmt: skip
         self.u, self.mu, self.states = u, mu, trial
+        if previous is not None:  # the multipliers' increment is not known: none
+            self._previous = (np.asarray(previous[0], dtype=float), mu, float(previous[1]))
         return len(history) - 1
-
-    def stored_energy(self) -> float:
-        """The total stored energy (J) of the committed fields: ½ uᵀK u of the linear blocks
-        and the nonlinear blocks' ``stored_energy_of_state`` (their internal work otherwise)."""
-        zero = np.zeros(len(self.system.blocks))
-        stored, _ = self.ops.stored_and_dissipated(self.states, zero)
-        return float(self.ops.strain_linear(self.u).sum() + stored.sum())
 
     # -- results -----------------------------------------------------------------------------
     def reactions(self) -> np.ndarray:

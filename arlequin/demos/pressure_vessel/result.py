@@ -14,7 +14,7 @@ JSON_KEYS = ("first_yield_pressure", "limit_load_reached", "limit_load", "n_elem
              "patch_fraction", "wall_time_s", "history")  # fmt: skip
 #: The keys of ``history``: one value per converged step (the initial state first).
 HISTORY_KEYS = ("pressure", "plastic_radius", "outer_displacement", "inner_displacement",
-                "newton_iterations", "residuals")  # fmt: skip
+                "newton_iterations", "residuals", "patch_fraction")  # fmt: skip
 UNITS = {
     "first_yield_pressure": "Pa",
     "limit_load": "Pa",
@@ -29,6 +29,8 @@ UNITS = {
     "newton_iterations": "1",
     "residuals": "1",
     "reference": "",
+    "adaptations": "",
+    "max_coarse_yield_ratio": "1",
 }
 
 
@@ -59,6 +61,15 @@ class PressureVesselResult(JsonResult):
         step's relative residuals; 0 and [] for the initial state).
     reference : dict
         Hill's values at the final pressure (sphere), first yield and the limit load.
+    adaptations : list of dict
+        With ``adaptive``: each growth of the patch, ``step``, ``time`` (the load factor of
+        the fields it started from), ``n_fine_elements``, ``patch_fraction`` (of the wall's
+        area), ``energy_jump`` (the relative change of the total stored energy across it),
+        ``rejected`` (the step was computed again). ``history["patch_fraction"]`` gives the
+        patch's share at every step.
+    max_coarse_yield_ratio : float or None
+        With ``adaptive``: the largest von Mises / σy of the coarse model outside the patch
+        over the accepted steps.
     """
 
     first_yield_pressure: float
@@ -71,6 +82,8 @@ class PressureVesselResult(JsonResult):
     history: dict[str, list[Any]]
     reference: dict[str, float] = field(default_factory=dict)
     config: dict[str, Any] = field(default_factory=dict)
+    adaptations: list[dict[str, Any]] = field(default_factory=list)
+    max_coarse_yield_ratio: float | None = None
 
     json_exclude = ("config",)
 

@@ -9,8 +9,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ...contract import SimulationError
 from ...io import QuasiStaticRunWriter, ResultsFolder
-from ...solvers import NewtonError, solve_quasi_static
+from ...solvers import solve_quasi_static
 from .hill import (
     cylinder_first_yield,
     cylinder_limit_load,
@@ -39,12 +40,20 @@ class _Recorder:
         q = setup.plastic_model.quadrature_points()
         self.radius = np.linalg.norm(np.asarray(q), axis=0)
         self.history: dict[str, list[Any]] = {k: [] for k in HISTORY_KEYS}
-        self._append(0.0, np.zeros(setup.problem.system().n_dofs), None, 0, [], 0.0)
+        self.fraction = _patch_fraction(setup.meshes)
+        dm = setup.problem.system().dofmap
+        self._append(0.0, np.zeros(dm.n_dofs), None, 0, [], dm)
 
-    def _append(self, pressure, u, state, iterations, residuals, _lam) -> None:
+    def on_adapt(self, solver: Any, adapt: Any) -> None:
+        """The patch grew: follow its mesh (quadrature points, inner node, bore dofs)."""
+        self.setup.follow(adapt)
+        q = self.setup.plastic_model.quadrature_points()
+        self.radius = np.linalg.norm(np.asarray(q), axis=0)
+        self.fraction = _patch_fraction(self.setup.meshes)
+        self.__dict__.pop("_er", None)
+
+    def _append(self, pressure, u, state, iterations, residuals, dm) -> None:
         s = self.setup
-        system = s.problem.system()
-        dm = system.dofmap
         block, node = s.outer_node
         self.history["outer_displacement"].append(float(u[dm[block].node_dofs([node])[0, 0]]))
         block, node = s.inner_node
@@ -55,6 +64,7 @@ class _Recorder:
         self.history["pressure"].append(float(pressure))
         self.history["newton_iterations"].append(int(iterations))
         self.history["residuals"].append([float(r) for r in residuals])
+        self.history["patch_fraction"].append(float(self.fraction))
 
     def pressure(self, solver: Any) -> float:
         if self.config.load_pressure is not None:
@@ -82,7 +92,7 @@ class _Recorder:
         rec = solver.history[-1]
         state = solver.states[self.setup.plastic_block][0]
         self._append(self.pressure(solver), solver.u, state, rec.iterations, rec.residuals,
-                     solver.t)  # fmt: skip
+                     solver.system.dofmap)  # fmt: skip
 
 
 def _bore_area(setup: VesselSetup, a: float) -> float:
@@ -158,8 +168,9 @@ def run(config: PressureVesselConfig, out: str | None = None,
         listeners.append(lambda solver: progress(solver.t))
     try:
         first_yield = _first_yield(config, setup)
-        qs = solve_quasi_static(setup.problem, load=1.0, steps=config.steps, on_step=listeners)
-    except NewtonError as err:
+        qs = solve_quasi_static(setup.problem, load=1.0, steps=config.steps, on_step=listeners,
+                                adapt=setup.adapt)  # fmt: skip
+    except SimulationError as err:
         if folder is not None:
             folder.add_results({"history": recorder.history})
             folder.finish("failed", str(err))
@@ -167,8 +178,6 @@ def run(config: PressureVesselConfig, out: str | None = None,
     mesh = setup.meshes
     n_el = (mesh.mono.nelements if mesh.mono is not None
             else mesh.coarse.nelements + mesh.patch.nelements)  # fmt: skip
-    area = _area(mesh.coarse)
-    fraction = 1.0 if mesh.patch is None else _area(mesh.patch) / area
     limit = qs.status == "limit_load"
     result = PressureVesselResult(
         first_yield_pressure=first_yield,
@@ -176,11 +185,13 @@ def run(config: PressureVesselConfig, out: str | None = None,
         limit_load=recorder.history["pressure"][-1] if limit else None,
         n_elements=int(n_el),
         n_dofs=int(system.n_dofs),
-        patch_fraction=float(fraction),
+        patch_fraction=_patch_fraction(mesh),
         wall_time_s=time.perf_counter() - start,
         history=recorder.history,
         reference=_reference(config, recorder.history["pressure"][-1]),
         config=config.inputs(),
+        adaptations=[a.to_json() for a in qs.adaptations],
+        max_coarse_yield_ratio=qs.max_coarse_yield_ratio,
     )
     if folder is not None:
         folder.add_results({k: v for k, v in result.to_json().items()}, UNITS)
@@ -188,6 +199,11 @@ def run(config: PressureVesselConfig, out: str | None = None,
         folder.finish("complete", qs.message)
     logger.info("%s", result.summary())
     return result
+
+
+def _patch_fraction(meshes: Any) -> float:
+    """The patch's share of the wall's area (1 for mono)."""
+    return 1.0 if meshes.patch is None else _area(meshes.patch) / _area(meshes.coarse)
 
 
 def _area(mesh: Any) -> float:
