@@ -154,3 +154,102 @@ def test_an_indicator_of_the_wrong_shape_is_refused():
     adapt = AdaptivePatch(indicator=lambda view: np.zeros(mesh.nelements - 1, dtype=bool))
     with pytest.raises(IndicatorError, match=f"shape \\({mesh.nelements},\\)"):
         solve_quasi_static(problem, steps=2, adapt=adapt)
+
+
+# -- the pressure sphere, adaptive (arlequin pressure-vessel --adaptive) -----------------------
+SMALL = {"coarse_size": 0.025, "fine_size": 0.025 / 4, "pressure": 2e8, "steps": 5}
+
+
+def test_adaptive_sphere_cli_json_series_and_history(tmp_path):
+    """4 coarse rings, 200 MPa in 5 steps (c = 116 mm): the one-ring seed yields in its band
+    at step 4, which is computed again on 3 rings (measured: energy jump 2.1e-2 at this
+    resolution, coarse σ_vm/σy at most 0.35). The patch's frames go into a new series after
+    the growth; the history has the patch's share at every step."""
+    import json
+
+    from arlequin.cli.main import main
+    from arlequin.io import read_history, read_series
+
+    out, js = tmp_path / "run", tmp_path / "pv.json"
+    argv = ["pressure-vessel", "--adaptive", "--pressure", "2e8", "--steps", "5",
+            "--coarse-size", "0.025", "--fine-size", "0.00625", "--out", str(out), "--json",
+            str(js), "--quiet"]  # fmt: skip
+    assert main(argv) == 0
+    data = json.loads(js.read_text())
+    (growth,) = data["adaptations"]
+    assert set(growth) >= {"step", "time", "n_fine_elements", "patch_fraction", "energy_jump"}
+    assert (
+        growth["step"] == 4 and growth["n_fine_elements"] == 3 * 9 * 16
+    )  # 3 rings of 9 cells, 16 fine each
+    assert 0.0 < data["max_coarse_yield_ratio"] < 1.0
+    fractions = data["history"]["patch_fraction"]
+    assert len(fractions) == 6 and fractions[-1] == pytest.approx(data["patch_fraction"])
+    assert fractions[3] < fractions[4]  # steps 1-3 on the seed, 4-5 on the grown patch
+    _, before = read_series(out / "fields" / "patch0.xdmf")
+    mesh, after = read_series(out / "fields" / "patch0_1.xdmf")
+    assert len(before) == 3 and len(after) == 2 and "eqps" in after[-1][2]
+    assert len(mesh.points) > 0
+    assert len(read_history(out / "newton.csv")["load_factor"]) == 5
+
+
+def test_adaptive_sphere_cap_stops_the_run_with_the_steps_on_disk(tmp_path):
+    """A cap below the growth the plastic zone asks for (0.5 of the wall): PatchLimitError,
+    the results folder marked failed with the three converged steps."""
+    import json
+
+    from arlequin.demos.pressure_vessel import run_pressure_vessel
+    from arlequin.io import read_history
+
+    with pytest.raises(PatchLimitError, match="max_fraction") as info:
+        run_pressure_vessel(adaptive=True, max_patch_fraction=0.5, out=str(tmp_path), **SMALL)
+    assert len(info.value.result.steps) == 3
+    meta = json.loads((tmp_path / "results.json").read_text())
+    assert meta["status"] == "failed"
+    assert len(read_history(tmp_path / "newton.csv")["load_factor"]) == 3
+
+
+@pytest.mark.parametrize(
+    ("options", "match"),
+    [
+        ({"adaptive": True, "adapt_threshold": 0.0}, "adapt_threshold"),
+        ({"adaptive": True, "adapt_threshold": 1.2}, "adapt_threshold"),
+        ({"adaptive": True, "adapt_buffer": -1}, "adapt_buffer"),
+        ({"adaptive": True, "adapt_every": 0}, "adapt_every"),
+        ({"adaptive": True, "max_patch_fraction": 0.0}, "max_patch_fraction"),
+        ({"adaptive": True, "model": "mono"}, "adaptive"),
+        ({"adaptive": True, "patch_outer": 0.15}, "patch_outer"),
+    ],
+)
+def test_adaptive_sphere_bad_input_named(options, match):
+    from arlequin.demos.pressure_vessel import PressureVesselConfig
+
+    with pytest.raises(ValueError, match=match):
+        PressureVesselConfig(**options)
+
+
+@pytest.mark.slow
+def test_adaptive_sphere_matches_the_fixed_patch_at_the_default_resolution():
+    """The issue's item 3: 64 fine cells across the wall, 300 MPa in 10 steps, from a one-ring
+    seed. Measured: c 157.8138 mm (fixed 157.8137), u_b 78.1246 µm (fixed 78.1261: −0.002%),
+    the coarse σ_vm/σy outside the patch at most 0.604, three growths (the first a rejected
+    step) to the fixed patch's 7 rings; wall times (3 runs each) 6.9–11.5 s adaptive, 8.4–11.1 s
+    fixed: T_adaptive / T_fixed 0.79 (medians). The bounds: the issue's 0.5%, σy, and its 1.3
+    on the faster of two runs each (the machine's cores are shared: single runs vary by 60%)."""
+    import time
+
+    from arlequin.demos.pressure_vessel import run_pressure_vessel
+
+    runs, times = {}, {True: [], False: []}
+    for _ in range(2):
+        for adaptive in (True, False):
+            start = time.perf_counter()
+            runs[adaptive] = run_pressure_vessel(adaptive=adaptive)
+            times[adaptive].append(time.perf_counter() - start)
+    a, f = runs[True], runs[False]
+    for key in ("plastic_radius", "outer_displacement"):
+        assert a.history[key][-1] == pytest.approx(f.history[key][-1], rel=0.005)
+    assert a.max_coarse_yield_ratio < 1.0
+    assert [g["step"] for g in a.adaptations] == [5, 7, 9]
+    assert all(abs(g["energy_jump"]) < 1e-2 for g in a.adaptations)  # measured <= 4.3e-3
+    assert a.patch_fraction == pytest.approx(f.patch_fraction)
+    assert min(times[True]) <= 1.3 * min(times[False]), times

@@ -120,6 +120,7 @@ class Adaptation:
             "patch_fraction": self.patch_fraction,
             "energy_jump": self.energy_jump,
             "rejected": self.rejected,
+            "newton_iterations": self.newton_iterations,
         }
 
 
