@@ -190,6 +190,7 @@ def test_adaptive_sphere_cli_json_series_and_history(tmp_path):
     assert len(before) == 3 and len(after) == 2 and "eqps" in after[-1][2]
     assert len(mesh.points) > 0
     assert len(read_history(out / "newton.csv")["load_factor"]) == 5
+    assert (out / "patch_1.png").exists() and (out / "patch_size.png").exists()
 
 
 def test_adaptive_sphere_cap_stops_the_run_with_the_steps_on_disk(tmp_path):

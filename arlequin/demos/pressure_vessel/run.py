@@ -147,7 +147,7 @@ def _reference(config: PressureVesselConfig, pressure: float) -> dict[str, float
 def run(config: PressureVesselConfig, out: str | None = None,
         progress: Callable[[float], None] | None = None) -> PressureVesselResult:  # fmt: skip
     """Run the vessel of ``config`` (see :mod:`arlequin.demos.pressure_vessel`)."""
-    from .report import cell_fields, write_pictures
+    from .report import AdaptationPictures, cell_fields, write_pictures
 
     start = time.perf_counter()
     setup = build(config)
@@ -164,6 +164,8 @@ def run(config: PressureVesselConfig, out: str | None = None,
         units = {"eqps": "1", "von_mises": "Pa"}
         writer = QuasiStaticRunWriter(folder, system, layout, cell_fields(setup), units)
         listeners.append(writer)
+        if setup.adapt is not None:
+            listeners.append(AdaptationPictures(folder, setup))
     if progress is not None:
         listeners.append(lambda solver: progress(solver.t))
     try:
