@@ -12,6 +12,8 @@ PatchCoupling                   set up a coupled problem (:mod:`arlequin.problem
 MultiBodyProblem                several bodies (problems or models) in one system
                                 (:mod:`arlequin.problem.bodies`)
 refine_region                   nested patches from coarse cells (:mod:`arlequin.coupling.patches`)
+AdaptivePatch, adapt            a nested patch that grows where the material yields
+                                (:mod:`arlequin.adapt`)
 RampWeights, ConstantWeights,
 CallableWeights                 partition weights (:mod:`arlequin.coupling.weights`)
 solve_static, solve,
@@ -94,6 +96,8 @@ def _cache_kernels_outside_the_package() -> None:
 
 _cache_kernels_outside_the_package()
 
+from . import adapt
+from .adapt import AdaptivePatch, PatchLimitError
 from .contract import (
     CapabilityError,
     ConstraintError,
@@ -120,6 +124,7 @@ from .solvers.static import SingularSystemError, StaticResult, solve_static
 __version__ = "0.1.0"
 
 __all__ = [
+    "AdaptivePatch",
     "ArlequinProblem",
     "CallableWeights",
     "CapabilityError",
@@ -137,6 +142,7 @@ __all__ = [
     "OverlapError",
     "Patch",
     "PatchCoupling",
+    "PatchLimitError",
     "QuasiStaticResult",
     "RampWeights",
     "ResultsFolder",
@@ -145,6 +151,7 @@ __all__ = [
     "StateError",
     "StaticResult",
     "WeightSumError",
+    "adapt",
     "build_overlap",
     "check_mesh",
     "evaluate_field",

@@ -60,6 +60,7 @@ import numpy as np
 __all__ = [
     "CAPABILITIES",
     "CapabilityError",
+    "CellStates",
     "ConstraintError",
     "ConstraintState",
     "ConstraintTrial",
@@ -68,6 +69,7 @@ __all__ = [
     "Model",
     "SimulationError",
     "StateError",
+    "SupportsCellStates",
     "SupportsCriticalTimeStep",
     "SupportsTangent",
     "UnilateralConstraint",
@@ -76,7 +78,9 @@ __all__ = [
     "is_linear",
     "is_unilateral",
     "node_dofs",
+    "put_cells",
     "require",
+    "take_cells",
 ]
 
 
@@ -223,6 +227,63 @@ class SupportsCriticalTimeStep(Protocol):
     def critical_time_step(self, u: np.ndarray, state: Any = None) -> float:
         """An estimate (s) of the critical step of central differences with the lumped mass at
         displacement u (m), never larger than the true value of the model alone (weight 1)."""
+
+
+@runtime_checkable
+class SupportsCellStates(Protocol):
+    """Optional members of a nonlinear model that adaptive patches call
+    (:mod:`arlequin.problem.adapt`): its state cut into cells and put back, and its yield stress.
+    Not a capability of the integrators (not in :data:`CAPABILITIES`); a model without them
+    cannot be the model of an adaptive patch. :class:`CellStates` gives the first two to any
+    model whose state is a dataclass of arrays of shape (…, n_elems, n_qp).
+    """
+
+    def state_of_cells(self, state: Any, cells: np.ndarray) -> Any:
+        """The state restricted to ``cells`` (the arrays' n_elems axis taken at them)."""
+
+    def with_cells(self, state: Any, cells: np.ndarray, part: Any) -> Any:
+        """A new state: ``state`` with its ``cells`` replaced by those of ``part`` (a state of
+        ``len(cells)`` cells, as :meth:`state_of_cells` returns)."""
+
+    def yield_stress(self, state: Any = None) -> np.ndarray:
+        """The current yield stress σ_y(ε̄p) (Pa), shape (n_elems, n_qp); σ_y0 for ``None``."""
+
+
+def take_cells(state: Any, cells: np.ndarray) -> Any:
+    """A state (a dataclass of arrays (…, n_elems, n_qp)) restricted to ``cells``."""
+    import dataclasses
+
+    cells = np.asarray(cells, dtype=np.int64)
+    values = {f.name: np.take(np.asarray(getattr(state, f.name)), cells, axis=-2)
+              for f in dataclasses.fields(state)}  # fmt: skip
+    return type(state)(**values)
+
+
+def put_cells(state: Any, cells: np.ndarray, part: Any) -> Any:
+    """A new state: ``state`` with its ``cells`` replaced by ``part``'s (both dataclasses of
+    arrays (…, n_elems, n_qp), ``part`` of ``len(cells)`` cells); ``state`` is not changed."""
+    import dataclasses
+
+    cells = np.asarray(cells, dtype=np.int64)
+    values = {}
+    for f in dataclasses.fields(state):
+        a = np.array(getattr(state, f.name), dtype=float)
+        a[..., cells, :] = np.asarray(getattr(part, f.name))
+        values[f.name] = a
+    return type(state)(**values)
+
+
+class CellStates:
+    """:meth:`state_of_cells` and :meth:`with_cells` of :class:`SupportsCellStates` for a
+    model whose state is a dataclass of arrays of shape (…, n_elems, n_qp)."""
+
+    def state_of_cells(self, state: Any, cells: np.ndarray) -> Any:
+        """The state at ``cells`` (:func:`take_cells`)."""
+        return take_cells(state, cells)
+
+    def with_cells(self, state: Any, cells: np.ndarray, part: Any) -> Any:
+        """``state`` with its ``cells`` replaced by ``part`` (:func:`put_cells`)."""
+        return put_cells(state, cells, part)
 
 
 #: The optional capabilities and their protocols.

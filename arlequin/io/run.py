@@ -133,6 +133,7 @@ class QuasiStaticRunWriter:
                  cell_data: Any = None, units: dict[str, str] | None = None,
                  replay: dict[str, Any] | None = None) -> None:  # fmt: skip
         self.system, self.layout, self.cell_data = system, layout, cell_data
+        self._folder = folder
         self.history = folder.history(
             self.columns,
             {
@@ -146,6 +147,7 @@ class QuasiStaticRunWriter:
             name="newton",
         )
         self.series = {bf.name: folder.series(bf.name, bf.mesh) for bf in layout.blocks}
+        self._meshes = {bf.name: bf.mesh for bf in layout.blocks}
         folder.meta.setdefault("field_units", {}).update({**layout.units, **(units or {})})
         if replay is not None:  # a resumed run: what the interrupted one had written, first
             for row in replay["rows"]:
@@ -169,6 +171,17 @@ class QuasiStaticRunWriter:
             p.stem: read_series(p)[1] for p in sorted((out / "fields").glob("*.xdmf"))
         }  # fmt: skip
         return {"rows": rows, "frames": frames}
+
+    def on_adapt(self, solver: Any, adapt: Any) -> None:
+        """A patch grew (``solve_quasi_static(..., adapt=)``): the next frames go on the new
+        system, the blocks whose mesh changed into a new series ``fields/NAME_K.xdmf`` (K the
+        growths so far: a meshio XDMF time series holds one mesh)."""
+        self.system, self.layout = solver.system, adapt.problem.field_layout()
+        self._growths = getattr(self, "_growths", 0) + 1
+        for bf in self.layout.blocks:
+            if bf.mesh is not self._meshes[bf.name]:
+                self.series[bf.name] = self._folder.series(f"{bf.name}_{self._growths}", bf.mesh)
+                self._meshes[bf.name] = bf.mesh
 
     def __call__(self, solver: Any) -> None:
         rec = solver.history[-1]

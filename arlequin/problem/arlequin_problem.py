@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -102,6 +102,19 @@ class ArlequinProblem:
             )
 
     # ------------------------------------------------------------------ set-up
+    def with_patches(self, patches: Sequence[Patch]) -> ArlequinProblem:
+        """A new problem with the same coarse model, ``mediator_dirichlet``, supports and loads
+        on other patches (the same number, their blocks named as this problem's: the supports
+        and loads given per block apply to the new patches' meshes, their selectors evaluated
+        there). Adaptive patches (:mod:`arlequin.problem.adapt`) grow a patch this way."""
+        patches = list(patches)
+        if len(patches) != len(self.patches):
+            raise ValueError(f"with_patches needs {len(self.patches)} patches, got {len(patches)}")
+        named = [replace(p, name=p.name or self._names[i + 1]) for i, p in enumerate(patches)]
+        new = ArlequinProblem(self.coarse, named, self.mediator_dirichlet)
+        new._loads, new._dirichlet = list(self._loads), list(self._dirichlet)
+        return new
+
     @property
     def block_names(self) -> list[str]:
         return list(self._names)

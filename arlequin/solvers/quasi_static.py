@@ -41,6 +41,7 @@ import numpy as np
 
 from ..contract import SimulationError, StateError
 from ..problem.system import CoupledSystem
+from .adaptive import AdaptableSolver, run_adaptive
 from .condensation import SaddleSolver
 from .constraints import is_unilateral
 from .operators import SystemOperators, as_system, as_vector
@@ -132,6 +133,12 @@ class QuasiStaticResult:
     states: dict[str, list[Any]]
     limit_load: float | None = None
     system: CoupledSystem | None = field(default=None, repr=False)
+    #: with ``adapt=``: the patch's growths (:class:`arlequin.problem.adapt.Adaptation`), the
+    #: largest σ_vm/σy of the coarse model outside the patch over the accepted steps, the
+    #: final problem
+    adaptations: list[Any] = field(default_factory=list)
+    max_coarse_yield_ratio: float | None = None
+    problem: Any = field(default=None, repr=False)
 
     @property
     def newton_iterations(self) -> list[int]:
@@ -152,7 +159,7 @@ class _StepFailed(Exception):
         self.kind = kind  # "newton", "state", "singular"
 
 
-class QuasiStaticSolver:
+class QuasiStaticSolver(AdaptableSolver):
     """Load stepping with Newton on a coupled system (see the module docstring).
 
     Parameters
@@ -185,7 +192,7 @@ class QuasiStaticSolver:
     t0, u0, states :
         Start (default λ = 0, zero displacement, the models' initial states).
     restore : dict, optional
-        A :meth:`snapshot` of an interrupted run of the same problem and options: the solver
+        A :meth:`checkpoint` of an interrupted run of the same problem and options: the solver
         continues from its last converged step, with the same steps and values as the
         uninterrupted run.
     """
@@ -230,6 +237,7 @@ class QuasiStaticSolver:
         self.max_backtracks = int(max_backtracks)
         self.ops = SystemOperators(self.system, lumped=False)
         self.ops.check_tangents("the quasi-static solver")
+        self.condense = bool(condense)
         self.saddle = SaddleSolver(self.system, self.ops, condense=condense)
         self.t = self.t0
         self.u = as_vector(u0, self.system, "u0")
@@ -429,16 +437,17 @@ class QuasiStaticSolver:
         )
 
     # -- checkpoints -------------------------------------------------------------------------
-    _SNAPSHOT = ("t", "u", "mu", "states", "dt", "history", "status", "_previous",
-                 "_first_stiffness", "_last_stiffness")  # fmt: skip
+    _CHECKPOINT = ("t", "u", "mu", "states", "dt", "history", "status", "_previous",
+                   "_first_stiffness", "_last_stiffness")  # fmt: skip
 
-    def snapshot(self) -> dict[str, Any]:
-        """The committed state of the run (picklable: arrays and immutable states), from which
-        ``QuasiStaticSolver(..., restore=snapshot)`` continues bit for bit."""
-        return {name: getattr(self, name) for name in self._SNAPSHOT}
+    def checkpoint(self) -> dict[str, Any]:
+        """The committed state of the run with its whole history (picklable: arrays and
+        immutable states), from which ``QuasiStaticSolver(..., restore=checkpoint)`` continues
+        bit for bit (:meth:`snapshot` is the lighter undo point of an adaptive run)."""
+        return {name: getattr(self, name) for name in self._CHECKPOINT}
 
     def _restore(self, snap: dict[str, Any]) -> None:
-        missing = [name for name in self._SNAPSHOT if name not in snap]
+        missing = [name for name in self._CHECKPOINT if name not in snap]
         if missing:
             raise ValueError(f"restore: the snapshot lacks {missing}")
         if np.shape(snap["u"]) != self.u.shape or np.shape(snap["mu"]) != self.mu.shape:
@@ -446,9 +455,40 @@ class QuasiStaticSolver:
                 f"restore: the snapshot is of another problem ({np.size(snap['u'])} dofs and "
                 f"{np.size(snap['mu'])} multipliers, this one {self.u.size} and {self.mu.size})"
             )
-        for name in self._SNAPSHOT:
+        for name in self._CHECKPOINT:
             setattr(self, name, snap[name])
         self.history = list(self.history)
+
+    # -- adaptation (arlequin.problem.adapt, driven by arlequin.solvers.adaptive) ------------
+    def replace_system(self, system: Any, u: np.ndarray, states: dict[str, list[Any]]) -> None:
+        """Go on with another system (a grown patch) from the fields ``u`` and ``states`` moved
+        onto it at the same load factor (blocks missing from ``states``: initial states); the
+        multipliers are zero until :meth:`resolve`."""
+        self.system = as_system(system)
+        self.ops = SystemOperators(self.system, lumped=False)
+        self.ops.check_tangents("the quasi-static solver")
+        self.saddle = SaddleSolver(self.system, self.ops, condense=self.condense)
+        self.u = as_vector(u, self.system, "u")
+        self.states = {**self.ops.initial_states(), **states}
+        self.mu = np.zeros(self.saddle.n_multipliers)
+        self._previous = None
+
+    def resolve(self, previous: tuple[np.ndarray, float] | None = None) -> int:
+        """Newton at the committed load factor from the committed fields (after
+        :meth:`replace_system`): commits u, μ and the states; returns the iterations.
+        ``previous``: the displacement of the step before (moved onto the new system) and its
+        load factor, for the next step's predictor (without it the next step starts from the
+        committed fields, as the first step)."""
+        self.mu = self._least_squares_multipliers()
+        try:
+            u, mu, trial, history = self._newton(self.t)
+        except _StepFailed as fail:
+            raise NewtonError(f"re-solving the grown patch at λ = {self.t:.6g} failed: {fail}",
+                              step=len(self.history), time=self.t) from fail  # fmt: skip
+        self.u, self.mu, self.states = u, mu, trial
+        if previous is not None:  # the multipliers' increment is not known: none
+            self._previous = (np.asarray(previous[0], dtype=float), mu, float(previous[1]))
+        return len(history) - 1
 
     # -- results -----------------------------------------------------------------------------
     def reactions(self) -> np.ndarray:
@@ -509,6 +549,7 @@ def solve_quasi_static(
     steps: int = 10,
     on_step: Sequence[Callable[[QuasiStaticSolver], Any]] = (),
     callback: Callable[[QuasiStaticSolver], bool] | None = None,
+    adapt: Any = None,
     **options: Any,
 ) -> QuasiStaticResult:
     """Solve a quasi-static problem by load stepping and Newton (see the module docstring).
@@ -525,6 +566,10 @@ def solve_quasi_static(
         ``solver.states``, ``solver.history[-1]``): to write results as the run goes.
     callback : callable, optional
         Called likewise; returning True stops the run (status ``"stopped"``).
+    adapt : AdaptivePatch, optional
+        A patch that grows where the material yields (:mod:`arlequin.problem.adapt`, driven by
+        :func:`arlequin.solvers.adaptive.run_adaptive`); listeners with an ``on_adapt(solver,
+        adapt)`` member are told of each growth.
     **options
         Passed to :class:`QuasiStaticSolver` (``proportional``, ``tol``, ``max_iterations``,
         ``min_step``, ``growth``, ``line_search``, ``condense``, ``reference_time``, ``t0``,
@@ -544,7 +589,11 @@ def solve_quasi_static(
     ValueError
         Bad input (named), before any work.
     """
+    if adapt is not None:
+        problem = adapt.bind(problem)
     solver = QuasiStaticSolver(problem, load=load, steps=steps, **options)
+    if adapt is not None:
+        return run_adaptive(solver, adapt, on_step, callback)
     while solver.status == "running":
         try:
             rec = solver.step()

@@ -39,7 +39,7 @@ import numpy as np
 import scipy.sparse as sp
 from skfem import Basis, Mesh
 
-from arlequin.contract import StateError
+from arlequin.contract import CellStates, StateError
 
 from ..elastic import LinearElastic, WeightLike
 from .hardening import Hardening
@@ -267,7 +267,7 @@ def consistent_tangent(result: ReturnResult, material: J2Material) -> np.ndarray
     return K * oo + g2 * (eye - oo / 3.0) + result.normal_coefficient * n[:, None] * n[None, :]
 
 
-class SmallStrainJ2:
+class SmallStrainJ2(CellStates):
     """Small-strain J2 elastoplastic model on one first-order mesh (quasi-static and implicit).
 
     Implements :class:`arlequin.contract.Model` with the capabilities ``"tangent"`` (the
@@ -403,8 +403,7 @@ class SmallStrainJ2:
         return self.elastic.mass(weight, lumped=lumped)
 
     def stiffness(self, weight: WeightLike = None) -> sp.csr_matrix:
-        """Weighted elastic stiffness (N/m): the tangent of the virgin state (with B̄ if
-        ``bbar``; without, :class:`LinearElastic`'s to round-off)."""
+        """Weighted elastic stiffness (N/m): the virgin state's tangent (B̄ with ``bbar``)."""
         zero = np.zeros(self.shape)
         virgin = ReturnResult(*(None,) * 6, np.zeros((self.ns, *self.shape)), zero, zero)
         return self._assemble_tangent(virgin, self._weights(weight))
@@ -569,6 +568,11 @@ class SmallStrainJ2:
         """Von Mises stress (Pa) at the quadrature points, shape (n_elems, n_qp)."""
         return state.von_mises
 
+    def yield_stress(self, state: SmallStrainState | None = None) -> np.ndarray:
+        """σ_y(ε̄p) (Pa), shape (n_elems, n_qp); σ_y0 for None (adaptive patches' member)."""
+        eqps = np.zeros(self.shape) if state is None else np.asarray(state.eqps)
+        return np.asarray(self.material.law.flow_stress(eqps), dtype=float) + 0.0 * eqps
+
     def equivalent_plastic_strain(self, state: SmallStrainState) -> np.ndarray:
         """ε̄p at the quadrature points, shape (n_elems, n_qp)."""
         return np.asarray(state.eqps)
@@ -588,9 +592,7 @@ class SmallStrainJ2:
         return float(np.sum(self._weights(weight) * psi))
 
     def stored_energy_of_state(self, state: SmallStrainState, weight: WeightLike = None) -> float:
-        """:meth:`stored_energy` (J), under the name the integrators' energy accounting looks
-        for (optional member of :class:`arlequin.contract.DynamicModel`, as
-        ``FiniteStrainJ2.stored_energy_of_state``)."""
+        """:meth:`stored_energy` (J): the energy member of ``contract.DynamicModel``."""
         return self.stored_energy(state, weight)
 
     def plastic_dissipation(self, state: SmallStrainState, weight: WeightLike = None) -> float:

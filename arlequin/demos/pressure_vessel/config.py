@@ -76,6 +76,20 @@ class PressureVesselConfig(DemoConfig):
                                      default_help="(b - a)/64")  # fmt: skip
     coarse_size: float | None = option(None, "radial size of the coarse cells", "m",
                                        metavar="H", default_help="(b - a)/8")  # fmt: skip
+    adaptive: bool = option(
+        False, "adaptive patch: a seed of one coarse ring at the bore that grows where the "
+        "material nears yield (--model arlequin)", "",
+    )  # fmt: skip
+    adapt_threshold: float = option(0.8, "coarse cells whose von Mises stress reaches BETA σy "
+                                    "join the patch", "1", metavar="BETA")  # fmt: skip
+    adapt_buffer: int = option(1, "rings of coarse cells added around the flagged ones", "1",
+                               metavar="RINGS")  # fmt: skip
+    adapt_every: int = option(1, "evaluate the indicator every N load steps (the yield check "
+                              "every step)", "1", metavar="N")  # fmt: skip
+    max_patch_fraction: float = option(
+        0.95, "largest share of the wall the adaptive patch may cover (beyond: the run stops)",
+        "1", metavar="F",
+    )  # fmt: skip
 
     # -- resolved values ---------------------------------------------------------------------
     @property
@@ -101,7 +115,9 @@ class PressureVesselConfig(DemoConfig):
 
     @property
     def patch_radius(self) -> float:
-        """The requested outer radius of the patch (m)."""
+        """The requested outer radius of the patch (m): one coarse ring when adaptive."""
+        if self.adaptive:
+            return self.inner + self.coarse
         if self.patch_outer is not None:
             return self.patch_outer
         return self.inner + PATCH_FRACTION * self.thickness
@@ -153,6 +169,21 @@ class PressureVesselConfig(DemoConfig):
                 f"coarse_size/fine_size = {self.coarse / self.fine:.6g} must be a power of 2 "
                 "(the patch is a nested refinement of the coarse cells)"
             )
+
+        self._check_adaptive()
+
+    def _check_adaptive(self) -> None:
+        check_range("adapt_threshold", self.adapt_threshold, 0.0, 1.0, closed="(]")
+        for name in ("adapt_buffer", "adapt_every"):
+            value, low = getattr(self, name), 1 if name == "adapt_every" else 0
+            if isinstance(value, bool) or int(value) != value or value < low:
+                raise ValueError(f"{name} must be an integer >= {low}, got {name}={value!r}")
+        check_range("max_patch_fraction", self.max_patch_fraction, 0.0, 1.0, closed="(]")
+        if self.adaptive and self.model != "arlequin":
+            raise ValueError(f"adaptive needs model='arlequin', got model={self.model!r}")
+        if self.adaptive and self.patch_outer is not None:
+            raise ValueError("adaptive starts from one ring at the bore: give no patch_outer, got "
+                             f"patch_outer={self.patch_outer}")  # fmt: skip
 
     # -- running -----------------------------------------------------------------------------
     def run(self, out: str | None = None, progress: Callable[[float], None] | None = None) -> Any:

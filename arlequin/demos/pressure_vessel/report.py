@@ -15,7 +15,14 @@ from .measures import von_mises
 from .result import PressureVesselResult
 from .setup import VesselSetup
 
-__all__ = ["cell_fields", "plot_plastic_zone", "plot_pressure_curve", "write_pictures"]
+__all__ = [
+    "AdaptationPictures",
+    "cell_fields",
+    "plot_patch_size",
+    "plot_plastic_zone",
+    "plot_pressure_curve",
+    "write_pictures",
+]
 
 
 def cell_fields(setup: VesselSetup) -> Callable[[Any], dict[str, dict[str, np.ndarray]]]:
@@ -101,3 +108,43 @@ def write_pictures(folder: ResultsFolder, setup: VesselSetup, qs: Any,
     plot_pressure_curve(result, result.config, str(folder.picture("pressure_displacement")))
     state = qs.states[setup.plastic_block][0]
     plot_plastic_zone(setup, state, str(folder.picture("plastic_zone")))
+    if result.adaptations:
+        plot_patch_size(result, str(folder.picture("patch_size")))
+
+
+class AdaptationPictures:
+    """A listener of an adaptive run: the plastic zone over the grown patch, one picture a
+    growth (``patch_K.png``, from the fields the growth started from, re-solved)."""
+
+    def __init__(self, folder: ResultsFolder, setup: VesselSetup) -> None:
+        self.folder, self.setup, self.count = folder, setup, 0
+
+    def __call__(self, solver: Any) -> None:
+        """Nothing after a step."""
+
+    def on_adapt(self, solver: Any, adapt: Any) -> None:
+        self.count += 1
+        state = solver.states[self.setup.plastic_block][0]
+        plot_plastic_zone(self.setup, state, str(self.folder.picture(f"patch_{self.count}")))
+
+
+def plot_patch_size(result: PressureVesselResult, path: str) -> None:
+    """The patch's share of the wall and the plastic front against the bore pressure."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    h = result.history
+    p = np.array(h["pressure"]) / 1e6
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.step(p, h["patch_fraction"], where="post", label="patch (share of the wall)")
+    a, b = result.config["inner"], result.config["outer"]
+    front = (np.array(h["plastic_radius"]) - a) / (b - a)
+    ax.plot(p, front, "o-", label="plastic front (share of the wall thickness)")
+    ax.set_xlabel("bore pressure (MPa)")
+    ax.set_ylim(0.0, 1.05)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)

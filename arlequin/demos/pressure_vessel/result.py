@@ -14,7 +14,7 @@ JSON_KEYS = ("first_yield_pressure", "limit_load_reached", "limit_load", "n_elem
              "patch_fraction", "wall_time_s", "history")  # fmt: skip
 #: The keys of ``history``: one value per converged step (the initial state first).
 HISTORY_KEYS = ("pressure", "plastic_radius", "outer_displacement", "inner_displacement",
-                "newton_iterations", "residuals")  # fmt: skip
+                "newton_iterations", "residuals", "patch_fraction")  # fmt: skip
 UNITS = {
     "first_yield_pressure": "Pa",
     "limit_load": "Pa",
@@ -29,6 +29,7 @@ UNITS = {
     "newton_iterations": "1",
     "residuals": "1",
     "reference": "",
+    "adaptations": "",
     "max_coarse_yield_ratio": "1",
 }
 
@@ -60,6 +61,12 @@ class PressureVesselResult(JsonResult):
         step's relative residuals; 0 and [] for the initial state).
     reference : dict
         Hill's values at the final pressure (sphere), first yield and the limit load.
+    adaptations : list of dict
+        With ``adaptive``: each growth of the patch, ``step``, ``time`` (the load factor of
+        the fields it started from), ``n_fine_elements``, ``patch_fraction`` (of the wall's
+        area), ``energy_jump`` (the relative change of the total stored energy across it),
+        ``rejected`` (the step was computed again). ``history["patch_fraction"]`` gives the
+        patch's share at every step.
     max_coarse_yield_ratio : float
         The largest von Mises stress / σy of the coarse elastic model outside the patch over
         the run (0 for ``mono``); above 1 the run warns (``CoarseYieldWarning``): the plastic
@@ -77,6 +84,7 @@ class PressureVesselResult(JsonResult):
     reference: dict[str, float] = field(default_factory=dict)
     max_coarse_yield_ratio: float = 0.0
     config: dict[str, Any] = field(default_factory=dict)
+    adaptations: list[dict[str, Any]] = field(default_factory=list)
 
     json_exclude = ("config",)
 

@@ -11,8 +11,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ...contract import SimulationError
 from ...io import QuasiStaticRunWriter, ResultsFolder, read_checkpoint, write_checkpoint
-from ...solvers import NewtonError, solve_quasi_static
+from ...solvers import solve_quasi_static
 from .hill import (
     cylinder_first_yield,
     cylinder_limit_load,
@@ -46,12 +47,20 @@ class _Recorder:
         q = setup.plastic_model.quadrature_points()
         self.radius = np.linalg.norm(np.asarray(q), axis=0)
         self.history: dict[str, list[Any]] = {k: [] for k in HISTORY_KEYS}
-        self._append(0.0, np.zeros(setup.problem.system().n_dofs), None, 0, [], 0.0)
+        self.fraction = _patch_fraction(setup.meshes)
+        dm = setup.problem.system().dofmap
+        self._append(0.0, np.zeros(dm.n_dofs), None, 0, [], dm)
 
-    def _append(self, pressure, u, state, iterations, residuals, _lam) -> None:
+    def on_adapt(self, solver: Any, adapt: Any) -> None:
+        """The patch grew: follow its mesh (quadrature points, inner node, bore dofs)."""
+        self.setup.follow(adapt)
+        q = self.setup.plastic_model.quadrature_points()
+        self.radius = np.linalg.norm(np.asarray(q), axis=0)
+        self.fraction = _patch_fraction(self.setup.meshes)
+        self.__dict__.pop("_er", None)
+
+    def _append(self, pressure, u, state, iterations, residuals, dm) -> None:
         s = self.setup
-        system = s.problem.system()
-        dm = system.dofmap
         block, node = s.outer_node
         self.history["outer_displacement"].append(float(u[dm[block].node_dofs([node])[0, 0]]))
         block, node = s.inner_node
@@ -62,6 +71,7 @@ class _Recorder:
         self.history["pressure"].append(float(pressure))
         self.history["newton_iterations"].append(int(iterations))
         self.history["residuals"].append([float(r) for r in residuals])
+        self.history["patch_fraction"].append(float(self.fraction))
 
     def pressure(self, solver: Any) -> float:
         if self.config.load_pressure is not None:
@@ -89,7 +99,7 @@ class _Recorder:
         rec = solver.history[-1]
         state = solver.states[self.setup.plastic_block][0]
         self._append(self.pressure(solver), solver.u, state, rec.iterations, rec.residuals,
-                     solver.t)  # fmt: skip
+                     solver.system.dofmap)  # fmt: skip
         self.max_coarse_yield_ratio = max(self.max_coarse_yield_ratio, self._coarse_ratio(solver))
 
     max_coarse_yield_ratio = 0.0
@@ -186,10 +196,10 @@ def run(config: PressureVesselConfig, out: str | None = None,
     listeners = _listeners(config, setup, folder, recorder, first_yield, progress, restore)
     try:
         qs = solve_quasi_static(
-            setup.problem, load=1.0, steps=config.steps, on_step=listeners,
+            setup.problem, load=1.0, steps=config.steps, on_step=listeners, adapt=setup.adapt,
             restore=None if restore is None else restore["solver"],
         )  # fmt: skip
-    except NewtonError as err:
+    except SimulationError as err:  # a Newton failure, the patch's cap
         if folder is not None:
             folder.add_results({"history": recorder.history})
             folder.finish("failed", str(err))
@@ -207,10 +217,11 @@ def run(config: PressureVesselConfig, out: str | None = None,
 
 def _listeners(config, setup, folder, recorder, first_yield, progress, restore) -> list:
     """What each converged step calls: the recorder, the results folder's writer (the frames
-    and rows of a resumed run first written again), the checkpoint, the progress."""
+    and rows of a resumed run first written again), the checkpoint (fixed patches: a growing
+    patch's problem is not in it), the adaptation pictures, the progress."""
     listeners: list[Callable[[Any], Any]] = [recorder]
     if folder is not None:
-        from .report import cell_fields
+        from .report import AdaptationPictures, cell_fields
 
         system = setup.problem.system()
         layout = setup.problem.field_layout()
@@ -218,16 +229,20 @@ def _listeners(config, setup, folder, recorder, first_yield, progress, restore) 
         replay = None if restore is None else restore["replay"]
         writer = QuasiStaticRunWriter(folder, system, layout, cell_fields(setup), units,
                                       replay=replay)  # fmt: skip
-        path = folder.path / CHECKPOINT
+        listeners.append(writer)
+        if setup.adapt is not None:
+            listeners.append(AdaptationPictures(folder, setup))
+        else:
+            path = folder.path / CHECKPOINT
 
-        def checkpoint(solver: Any) -> None:
-            write_checkpoint(path, {
-                "config": config, "solver": solver.snapshot(), "history": recorder.history,
-                "max_coarse_yield_ratio": recorder.max_coarse_yield_ratio,
-                "first_yield_pressure": first_yield,
-            })  # fmt: skip
+            def checkpoint(solver: Any) -> None:
+                write_checkpoint(path, {
+                    "config": config, "solver": solver.checkpoint(), "history": recorder.history,
+                    "max_coarse_yield_ratio": recorder.max_coarse_yield_ratio,
+                    "first_yield_pressure": first_yield,
+                })  # fmt: skip
 
-        listeners += [writer, checkpoint]
+            listeners.append(checkpoint)
     if progress is not None:
         listeners.append(lambda solver: progress(solver.t))
     return listeners
@@ -238,27 +253,30 @@ def _result(config, setup, qs, recorder, first_yield, wall) -> PressureVesselRes
     mesh = setup.meshes
     n_el = (mesh.mono.nelements if mesh.mono is not None
             else mesh.coarse.nelements + mesh.patch.nelements)  # fmt: skip
-    fraction = 1.0 if mesh.patch is None else _area(mesh.patch) / _area(mesh.coarse)
     limit = qs.status == "limit_load"
+    ratio = recorder.max_coarse_yield_ratio
+    if qs.max_coarse_yield_ratio is not None:  # a growing patch: the solver's, at every step
+        ratio = max(ratio, qs.max_coarse_yield_ratio)
     result = PressureVesselResult(
         first_yield_pressure=first_yield,
         limit_load_reached=limit,
         limit_load=recorder.history["pressure"][-1] if limit else None,
         n_elements=int(n_el),
-        n_dofs=int(setup.problem.system().n_dofs),
-        patch_fraction=float(fraction),
+        n_dofs=int(qs.u.size),
+        patch_fraction=_patch_fraction(mesh),
         wall_time_s=wall,
         history=recorder.history,
         reference=_reference(config, recorder.history["pressure"][-1]),
-        max_coarse_yield_ratio=recorder.max_coarse_yield_ratio,
         config=config.inputs(),
+        adaptations=[a.to_json() for a in qs.adaptations],
+        max_coarse_yield_ratio=ratio,
     )
-    if recorder.max_coarse_yield_ratio > 1.0:
+    if ratio > 1.0:
         warnings.warn(
             f"the coarse elastic model outside the patch carries von Mises stresses up to "
-            f"{recorder.max_coarse_yield_ratio:.3f} times the yield stress: the plastic zone "
-            "has outgrown the patch, and the results past that load are not those of the J2 "
-            "material (widen --patch-outer, or use --model mono)",
+            f"{ratio:.3f} times the yield stress: the plastic zone has outgrown the patch, "
+            "and the results past that load are not those of the J2 material (widen "
+            "--patch-outer, use --adaptive, or --model mono)",
             CoarseYieldWarning,
             stacklevel=3,
         )
@@ -268,10 +286,15 @@ def _result(config, setup, qs, recorder, first_yield, wall) -> PressureVesselRes
 def resume(out: str, progress: Callable[[float], None] | None = None) -> PressureVesselResult:
     """Continue the interrupted run whose results folder is ``out`` from its last converged
     step (its checkpoint), with the inputs it was started with; the same steps and values as
-    the uninterrupted run."""
+    the uninterrupted run. Runs with a growing patch write no checkpoint."""
     snap = read_checkpoint(Path(out) / CHECKPOINT)
     snap["replay"] = QuasiStaticRunWriter.written(out)
     return run(snap["config"], out=out, progress=progress, restore=snap)
+
+
+def _patch_fraction(meshes: Any) -> float:
+    """The patch's share of the wall's area (1 for mono)."""
+    return 1.0 if meshes.patch is None else _area(meshes.patch) / _area(meshes.coarse)
 
 
 def _area(mesh: Any) -> float:

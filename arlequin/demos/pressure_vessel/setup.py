@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import logging
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -20,8 +20,9 @@ import numpy as np
 from ...coupling.exactness import ExactnessWarning
 from ...coupling.gluing import Patch
 from ...models import FiniteStrainJ2, IsotropicElastic, J2Material, LinearElastic
+from ...problem.adapt import AdaptivePatch
 from ...problem.arlequin_problem import ArlequinProblem
-from .meshes import VesselMeshes, vessel_meshes
+from .meshes import VesselMeshes, refine_projected, vessel_meshes
 
 if TYPE_CHECKING:  # annotations only: the configuration runs this module
     from .config import PressureVesselConfig
@@ -53,6 +54,9 @@ class VesselSetup:
         (a, 0) of the model that carries them.
     bore_blocks : list of str
         The blocks whose bore nodes are prescribed under ``inner_displacement``.
+    adapt : AdaptivePatch or None
+        With ``adaptive``: the patch that grows from its one-ring seed (its rings refined
+        with the bore's new nodes on the circle, as the fixed patch).
     """
 
     problem: ArlequinProblem
@@ -63,6 +67,17 @@ class VesselSetup:
     outer_node: tuple[str, int]
     inner_node: tuple[str, int]
     bore_blocks: list[str]
+    adapt: AdaptivePatch | None = None
+
+    def follow(self, adapt: AdaptivePatch) -> None:
+        """After a growth: the problem, the J2 model, the meshes and the inner node of the
+        grown patch."""
+        self.problem = adapt.problem
+        self.plastic_model = self.problem.patches[0].model
+        mesh = self.plastic_model.mesh
+        self.meshes = replace(self.meshes, patch=mesh)
+        a = float(np.linalg.norm(self.meshes.coarse.p, axis=0).min())
+        self.inner_node = ("patch0", _node_at(mesh, (a,) + (0.0,) * (mesh.dim() - 1)))
 
 
 def _plastic_model(config: PressureVesselConfig, mesh: Any, kind: str) -> Any:
@@ -87,6 +102,17 @@ def _node_at(mesh: Any, x: tuple[float, float]) -> int:
 def _on_bore(a: float):
     # facet midpoints (chords lie inside the circle) and nodes (on it) of the bore
     return lambda x: np.linalg.norm(x, axis=0) <= a * (1.0 + 1e-9)
+
+
+def _whole_rings(mesh: Any):
+    """The adaptive patch's closure: every coarse cell whose centre lies within the outermost
+    ring of the cells given (the patch stays a set of rings, its gluing band a ring)."""
+    radius = np.linalg.norm(mesh.p[:, mesh.t].mean(axis=1), axis=0)
+
+    def closure(mask: np.ndarray) -> np.ndarray:
+        return mask | (radius <= radius[mask].max() * (1.0 + 1e-9))
+
+    return closure
 
 
 def build(config: PressureVesselConfig) -> VesselSetup:
@@ -136,4 +162,21 @@ def build(config: PressureVesselConfig) -> VesselSetup:
             problem.add_dirichlet(
                 block, _on_bore(a), value=lambda x: u_bore * x / np.linalg.norm(x, axis=0)
             )
-    return VesselSetup(problem, meshes, plastic_block, plastic, kind, outer, inner, blocks)
+    adapt = None
+    if config.adaptive:
+        coarse_mesh, levels = meshes.coarse, meshes.levels
+        adapt = AdaptivePatch(
+            model_factory=lambda mesh: _plastic_model(config, mesh, kind),
+            levels=levels,
+            refine=lambda cells: refine_projected(coarse_mesh, levels, (a,), cells),
+            threshold=config.adapt_threshold,
+            buffer=config.adapt_buffer,
+            # grow when the plastic zone comes within one coarse ring of the band (a load
+            # step moves the front by several fine cells: closer, it would enter the band and
+            # the step be computed again)
+            band_cells=2**levels,
+            every=config.adapt_every,
+            max_fraction=config.max_patch_fraction,
+            closure=_whole_rings(coarse_mesh),
+        )
+    return VesselSetup(problem, meshes, plastic_block, plastic, kind, outer, inner, blocks, adapt)

@@ -1,0 +1,28 @@
+"""``arlequin.adapt``: adaptive patches, one concept (issue 31) under the name the issue gives it.
+
+The patch that grows (:class:`AdaptivePatch`, its records and errors) lives in
+:mod:`arlequin.problem.adapt`, with the problem it rebuilds; the load stepping that drives it in
+:mod:`arlequin.solvers.adaptive` (``solve_quasi_static(problem, ..., adapt=AdaptivePatch())``).
+"""
+
+from .problem.adapt import (
+    Adaptation,
+    AdaptivePatch,
+    AdaptView,
+    Growth,
+    IndicatorError,
+    NonNestedPatchError,
+    PatchLimitError,
+)
+from .solvers.adaptive import run_adaptive
+
+__all__ = [
+    "AdaptView",
+    "Adaptation",
+    "AdaptivePatch",
+    "Growth",
+    "IndicatorError",
+    "NonNestedPatchError",
+    "PatchLimitError",
+    "run_adaptive",
+]
