@@ -113,6 +113,7 @@ class Adaptation:
     wall_time_s: float = 0.0
 
     def to_json(self) -> dict[str, Any]:
+        """The adaptation as plain JSON (an entry of the demos' ``adaptations``)."""
         return {
             "step": self.step,
             "time": self.time,

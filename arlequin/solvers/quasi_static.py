@@ -34,17 +34,16 @@ from __future__ import annotations
 import logging
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from ..contract import SimulationError, StateError
-from ..problem.system import CoupledSystem
+from ..contract import StateError
 from .adaptive import AdaptableSolver, run_adaptive
 from .condensation import SaddleSolver
 from .constraints import is_unilateral
 from .operators import SystemOperators, as_system, as_vector
+from .quasi_static_result import STATUSES, NewtonError, QuasiStaticResult, QuasiStaticStep
 
 __all__ = [
     "STATUSES",
@@ -57,98 +56,9 @@ __all__ = [
 
 logger = logging.getLogger(__name__)
 
-#: How a quasi-static run ends: the target load reached, a limit load, a stop asked by the
-#: callback.
-STATUSES = ("completed", "limit_load", "stopped")
-
 #: Below this ratio of the current incremental stiffness to the first step's, a load that
 #: cannot increase is reported as a limit load (Bergan's current stiffness parameter).
 LIMIT_STIFFNESS_RATIO = 0.05
-
-
-class NewtonError(SimulationError):
-    """Newton's method failed at the smallest load step (or a model's state was invalid there):
-    the run stops; ``result`` holds every converged step."""
-
-
-@dataclass(frozen=True)
-class QuasiStaticStep:
-    """One converged load step.
-
-    Attributes
-    ----------
-    load_factor : float
-        λ at the end of the step.
-    step : float
-        Δλ of the step (after any cut).
-    iterations : int
-        Newton iterations.
-    residuals : tuple of float
-        The relative residual before each iteration and after the last.
-    cuts : int
-        How many times the step was cut before it converged.
-    """
-
-    load_factor: float
-    step: float
-    iterations: int
-    residuals: tuple[float, ...]
-    cuts: int
-
-
-@dataclass
-class QuasiStaticResult:
-    """What :func:`solve_quasi_static` computed.
-
-    Attributes
-    ----------
-    status : {"completed", "limit_load", "stopped"}
-    message : str
-    load_factors : list of float
-        λ of the initial state and of every converged step.
-    steps : list of QuasiStaticStep
-    u : ndarray, shape (n,)
-        Final displacement (m).
-    displacements : dict
-        Block name -> final displacement (m).
-    multipliers : dict
-        Constraint name -> final multipliers (the constraint's dual unit: N for L2 rows on
-        displacements in m... see the constraint).
-    reactions : ndarray, shape (n,)
-        Reaction forces at the Dirichlet dofs (N), zero elsewhere: f_int − f_ext there.
-    states : dict
-        Block name -> the committed model states of its terms.
-    limit_load : float or None
-        The last converged λ when the run ended at a limit load.
-    """
-
-    status: str
-    message: str
-    load_factors: list[float]
-    steps: list[QuasiStaticStep]
-    u: np.ndarray
-    displacements: dict[str, np.ndarray]
-    multipliers: dict[str, np.ndarray]
-    reactions: np.ndarray
-    states: dict[str, list[Any]]
-    limit_load: float | None = None
-    system: CoupledSystem | None = field(default=None, repr=False)
-    #: with ``adapt=``: the patch's growths (:class:`arlequin.problem.adapt.Adaptation`), the
-    #: largest σ_vm/σy of the coarse model outside the patch over the accepted steps, the
-    #: final problem
-    adaptations: list[Any] = field(default_factory=list)
-    max_coarse_yield_ratio: float | None = None
-    problem: Any = field(default=None, repr=False)
-
-    @property
-    def newton_iterations(self) -> list[int]:
-        """Newton iterations of every converged step."""
-        return [s.iterations for s in self.steps]
-
-    @property
-    def residuals(self) -> list[list[float]]:
-        """Relative residuals of every converged step's iterations."""
-        return [list(s.residuals) for s in self.steps]
 
 
 class _StepFailed(Exception):

@@ -123,6 +123,7 @@ class AdaptationPictures:
         """Nothing after a step."""
 
     def on_adapt(self, solver: Any, adapt: Any) -> None:
+        """A picture of the patch just grown (called by the adaptation after each growth)."""
         self.count += 1
         state = solver.states[self.setup.plastic_block][0]
         plot_plastic_zone(self.setup, state, str(self.folder.picture(f"patch_{self.count}")))

@@ -1,0 +1,103 @@
+"""What a quasi-static run gives back: its converged steps, its result, its failure
+(:func:`arlequin.solvers.quasi_static.solve_quasi_static`). SI units."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..contract import SimulationError
+from ..problem.system import CoupledSystem
+
+__all__ = ["STATUSES", "NewtonError", "QuasiStaticResult", "QuasiStaticStep"]
+
+#: How a quasi-static run ends: the target load reached, a limit load, a stop asked by the
+#: callback.
+STATUSES = ("completed", "limit_load", "stopped")
+
+
+class NewtonError(SimulationError):
+    """Newton's method failed at the smallest load step (or a model's state was invalid there):
+    the run stops; ``result`` holds every converged step."""
+
+
+@dataclass(frozen=True)
+class QuasiStaticStep:
+    """One converged load step.
+
+    Attributes
+    ----------
+    load_factor : float
+        λ at the end of the step.
+    step : float
+        Δλ of the step (after any cut).
+    iterations : int
+        Newton iterations.
+    residuals : tuple of float
+        The relative residual before each iteration and after the last.
+    cuts : int
+        How many times the step was cut before it converged.
+    """
+
+    load_factor: float
+    step: float
+    iterations: int
+    residuals: tuple[float, ...]
+    cuts: int
+
+
+@dataclass
+class QuasiStaticResult:
+    """What :func:`solve_quasi_static` computed.
+
+    Attributes
+    ----------
+    status : {"completed", "limit_load", "stopped"}
+    message : str
+    load_factors : list of float
+        λ of the initial state and of every converged step.
+    steps : list of QuasiStaticStep
+    u : ndarray, shape (n,)
+        Final displacement (m).
+    displacements : dict
+        Block name -> final displacement (m).
+    multipliers : dict
+        Constraint name -> final multipliers (the constraint's dual unit: N for L2 rows on
+        displacements in m... see the constraint).
+    reactions : ndarray, shape (n,)
+        Reaction forces at the Dirichlet dofs (N), zero elsewhere: f_int − f_ext there.
+    states : dict
+        Block name -> the committed model states of its terms.
+    limit_load : float or None
+        The last converged λ when the run ended at a limit load.
+    """
+
+    status: str
+    message: str
+    load_factors: list[float]
+    steps: list[QuasiStaticStep]
+    u: np.ndarray
+    displacements: dict[str, np.ndarray]
+    multipliers: dict[str, np.ndarray]
+    reactions: np.ndarray
+    states: dict[str, list[Any]]
+    limit_load: float | None = None
+    system: CoupledSystem | None = field(default=None, repr=False)
+    #: with ``adapt=``: the patch's growths (:class:`arlequin.problem.adapt.Adaptation`), the
+    #: largest σ_vm/σy of the coarse model outside the patch over the accepted steps, the
+    #: final problem
+    adaptations: list[Any] = field(default_factory=list)
+    max_coarse_yield_ratio: float | None = None
+    problem: Any = field(default=None, repr=False)
+
+    @property
+    def newton_iterations(self) -> list[int]:
+        """Newton iterations of every converged step."""
+        return [s.iterations for s in self.steps]
+
+    @property
+    def residuals(self) -> list[list[float]]:
+        """Relative residuals of every converged step's iterations."""
+        return [list(s.residuals) for s in self.steps]
