@@ -100,6 +100,7 @@ from . import adapt
 from .adapt import AdaptivePatch, PatchLimitError
 from .contract import (
     CapabilityError,
+    CoarseYieldWarning,
     ConstraintError,
     ContractError,
     SimulationError,
@@ -128,6 +129,7 @@ __all__ = [
     "ArlequinProblem",
     "CallableWeights",
     "CapabilityError",
+    "CoarseYieldWarning",
     "ConstantWeights",
     "ConstraintError",
     "ContractError",

@@ -61,6 +61,7 @@ __all__ = [
     "CAPABILITIES",
     "CapabilityError",
     "CellStates",
+    "CoarseYieldWarning",
     "ConstraintError",
     "ConstraintState",
     "ConstraintTrial",
@@ -113,6 +114,12 @@ class SimulationError(ValueError):
         self.step = int(step)
         self.time = float(time)
         self.result: Any = None
+
+
+class CoarseYieldWarning(UserWarning):
+    """A coarse (linear-elastic) model carries von Mises stresses above the yield stress of its
+    patches' material outside the patches: the plastic zone has outgrown them, and the results
+    past that load are not those of the elastoplastic material."""
 
 
 class ConstraintError(ValueError):

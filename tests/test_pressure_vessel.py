@@ -83,7 +83,7 @@ def test_an_outgrown_patch_is_reported():
     """The cylinder pressed past its limit load with the patch to 187.5 mm: the elastic ring
     outside carries the load the plastic wall cannot (no limit load): the run warns and says by
     how much the coarse model exceeds the yield stress (measured 2.5 times)."""
-    from arlequin.demos.pressure_vessel.run import CoarseYieldWarning
+    from arlequin import CoarseYieldWarning
 
     with pytest.warns(CoarseYieldWarning, match="outgrown the patch"):
         r = run_pressure_vessel(shape="cylinder", pressure=2.4e8, steps=8, **COARSE)

@@ -156,3 +156,28 @@ def test_solve_static_of_a_yielding_j2_patch_is_elastoplastic():
     # the tip is in the patch, which carries the energy there (measured ratio 2.32)
     tip = np.max(plastic.displacements["patch0"][0::2])
     assert tip > 1.2 * np.max(elastic.displacements["patch0"][0::2])
+
+
+def test_a_coarse_model_past_yield_outside_the_patch_is_reported():
+    """A J2 patch over half the bar: pulled at 350 MPa the coarse elastic half outside the
+    patch carries at least 1.3 times the yield stress (240 MPa; von Mises of a plane strain bar
+    free laterally: σ √(1 − ν + ν²) = 0.89 σ, and more at the clamped corners: 1.53 measured):
+    CoarseYieldWarning and max_coarse_yield_ratio > 1; at 100 MPa it stays below 1 (0.38
+    measured), without a warning."""
+    import warnings
+
+    from arlequin import CoarseYieldWarning
+    from arlequin.models import J2Material, SmallStrainJ2
+
+    mat = J2Material(210e9, 0.3, 7850.0, 240e6, hardening_modulus=10e9)
+
+    def patch(m):
+        return SmallStrainJ2(m, mat, "plane_strain", bbar=True)
+
+    with pytest.warns(CoarseYieldWarning, match="outgrown the patches"):
+        high = solve_quasi_static(_problem(patch, 3.5e8), load=1.0, steps=2)
+    assert high.max_coarse_yield_ratio >= 3.5e8 * 0.889 / 240e6
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", CoarseYieldWarning)
+        low = solve_quasi_static(_problem(patch, 1.0e8), load=1.0, steps=1)
+    assert 0.0 < low.max_coarse_yield_ratio < 1.0

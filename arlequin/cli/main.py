@@ -66,6 +66,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except ValueError as exc:  # bad input (every input error of the library is a ValueError)
         print(f"arlequin {args.command}: error: {exc}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:  # Ctrl-C: what was written stays (resumable demos: --resume)
+        print(f"arlequin {args.command}: interrupted", file=sys.stderr)
+        return 130
     except NonFiniteResult as exc:
         print(f"arlequin {args.command}: failed: {exc}", file=sys.stderr)
         return 1

@@ -388,6 +388,30 @@ class ArlequinProblem:
         )
         return FieldLayout([coarse, *blocks], multipliers)
 
+    def coarse_yield_ratio(self, u: np.ndarray) -> float | None:
+        """The largest von Mises stress of the coarse model outside every patch over the
+        smallest initial yield stress of the patches' materials, at the global displacement
+        ``u`` (m); None when the coarse model gives no stress (``stress_at_quadrature``) or no
+        patch a yield stress (``yield_stress``, :class:`arlequin.contract.SupportsCellStates`).
+        Above 1, the plastic zone has outgrown the patches."""
+        stress = getattr(self.coarse, "stress_at_quadrature", None)
+        yields = [
+            float(np.min(p.model.yield_stress(None)))
+            for p in self.patches
+            if callable(getattr(p.model, "yield_stress", None))
+        ]
+        if stress is None or not yields:
+            return None
+        outside = np.ones(self.coarse.mesh.nelements, dtype=bool)
+        for pc in self.couplings:
+            outside[pc.overlap.coarse_cells] = False
+        if not outside.any():
+            return 0.0
+        s = stress(u[self.dofmap()["coarse"].slice])[:, :, outside]
+        dev = s - np.einsum("ii...->...", s)[None, None] / 3.0 * np.eye(3)[:, :, None, None]
+        vm = np.sqrt(1.5 * np.einsum("ij...,ij...->...", dev, dev))
+        return float(vm.max() / min(yields))
+
     def mediator_rows(self, pc: PatchCoupling) -> np.ndarray:
         """Boolean mask of the mediator functions of ``pc`` kept as coupling rows (all of them,
         unless ``mediator_dirichlet="drop"``)."""

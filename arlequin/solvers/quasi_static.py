@@ -33,12 +33,13 @@ from __future__ import annotations
 
 import logging
 import math
+import warnings
 from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
 
-from ..contract import StateError
+from ..contract import CoarseYieldWarning, StateError
 from .adaptive import AdaptableSolver, run_adaptive
 from .condensation import SaddleSolver
 from .constraints import is_unilateral
@@ -504,6 +505,7 @@ def solve_quasi_static(
     solver = QuasiStaticSolver(problem, load=load, steps=steps, **options)
     if adapt is not None:
         return run_adaptive(solver, adapt, on_step, callback)
+    watch = _CoarseYieldWatch(problem)
     while solver.status == "running":
         try:
             rec = solver.step()
@@ -512,9 +514,44 @@ def solve_quasi_static(
             raise
         if rec is None:  # a limit load
             break
+        watch(solver)
         for listener in on_step:
             listener(solver)
         if callback is not None and callback(solver):
             solver.status = "stopped"
-            return solver.result(f"stopped by the callback at λ = {solver.t:.6g}")
-    return solver.result()
+            return watch.finish(solver.result(f"stopped by the callback at λ = {solver.t:.6g}"))
+    return watch.finish(solver.result())
+
+
+class _CoarseYieldWatch:
+    """The largest coarse von Mises / σy outside the patches over the steps, for a problem that
+    can tell it (``coarse_yield_ratio``, an ``ArlequinProblem`` with J2 patches); a
+    :class:`~arlequin.contract.CoarseYieldWarning` once it passes 1."""
+
+    def __init__(self, problem: Any) -> None:
+        self.ratio_of = getattr(problem, "coarse_yield_ratio", None)
+        self.worst: float | None = None
+        self.warned = False
+
+    def __call__(self, solver: Any) -> None:
+        if self.ratio_of is None:
+            return
+        ratio = self.ratio_of(solver.u)
+        if ratio is None:
+            self.ratio_of = None
+            return
+        self.worst = ratio if self.worst is None else max(self.worst, ratio)
+        if ratio > 1.0 and not self.warned:
+            self.warned = True
+            warnings.warn(
+                f"at λ = {solver.t:.6g} the coarse model outside the patches carries von Mises "
+                f"stresses {ratio:.3f} times the patches' yield stress: the plastic zone has "
+                "outgrown the patches (the results past this load are not those of the "
+                "elastoplastic material: widen the patches, or use an AdaptivePatch)",
+                CoarseYieldWarning,
+                stacklevel=3,
+            )
+
+    def finish(self, result: QuasiStaticResult) -> QuasiStaticResult:
+        result.max_coarse_yield_ratio = self.worst
+        return result

@@ -60,7 +60,8 @@ class PressureVesselConfig(DemoConfig):
                            choices=MATERIALS)  # fmt: skip
     pressure: float | None = option(
         None, "final internal pressure", "Pa", metavar="P", exclusive="load",
-        default_help="3e8 Pa unless --inner-displacement",
+        default_help="3e8 Pa for the sphere, 1.8e8 Pa for the cylinder, unless "
+        "--inner-displacement",
     )  # fmt: skip
     inner_displacement: float | None = option(
         None, "final radial displacement of the bore, instead of a pressure", "m", metavar="U",
@@ -97,7 +98,11 @@ class PressureVesselConfig(DemoConfig):
         """The final pressure (Pa), None under a prescribed bore displacement."""
         if self.inner_displacement is not None:
             return None
-        return 3e8 if self.pressure is None else self.pressure
+        if self.pressure is not None:
+            return self.pressure
+        # the sphere's default (Hill's 300 MPa state); the cylinder's limit load is 192 MPa at
+        # the default radii, so its default stays below it
+        return 3e8 if self.shape == "sphere" else 1.8e8
 
     @property
     def thickness(self) -> float:
@@ -184,6 +189,14 @@ class PressureVesselConfig(DemoConfig):
         if self.adaptive and self.patch_outer is not None:
             raise ValueError("adaptive starts from one ring at the bore: give no patch_outer, got "
                              f"patch_outer={self.patch_outer}")  # fmt: skip
+
+    def inputs(self) -> dict[str, Any]:
+        """The parameters as recorded, the defaults the run resolved filled in (the pressure,
+        the patch's radius, the cell sizes)."""
+        out = super().inputs()
+        out.update(pressure=self.load_pressure, patch_outer=self.patch_radius,
+                   fine_size=self.fine, coarse_size=self.coarse)  # fmt: skip
+        return out
 
     # -- running -----------------------------------------------------------------------------
     def run(self, out: str | None = None, progress: Callable[[float], None] | None = None) -> Any:

@@ -31,6 +31,8 @@ UNITS = {
     "reference": "",
     "adaptations": "",
     "max_coarse_yield_ratio": "1",
+    "final": "Pa (pressure), m (radius, displacements)",
+    "history": "Pa (pressure), m (radius, displacements), 1 (iterations, residuals)",
 }
 
 
@@ -88,8 +90,23 @@ class PressureVesselResult(JsonResult):
 
     json_exclude = ("config",)
 
+    @property
+    def final(self) -> dict[str, float]:
+        """The last converged state: ``pressure`` (Pa), ``plastic_radius``,
+        ``outer_displacement``, ``inner_displacement`` (m) (scalars for tables and studies)."""
+        keys = ("pressure", "plastic_radius", "outer_displacement", "inner_displacement")
+        return {k: float(self.history[k][-1]) for k in keys}
+
+    def to_json(self) -> dict[str, Any]:
+        """The Interface's keys, then ``final`` (the last converged state's scalars, which a
+        study's table shows) and the rest."""
+        data = super().to_json()
+        data["final"] = self.final
+        return data
+
     def summary(self) -> str:
-        """One line: first yield, the final state, Newton."""
+        """One line: first yield, the final state (against Hill's for the sphere), Newton, and
+        a warning when the coarse model outside the patch went past yield."""
         h = self.history
         its = h["newton_iterations"][1:]
         end = (f"limit load {self.limit_load / 1e6:.2f} MPa" if self.limit_load_reached
@@ -100,4 +117,19 @@ class PressureVesselResult(JsonResult):
             f"{h['plastic_radius'][-1] * 1e3:.3f} mm, outer displacement "
             f"{h['outer_displacement'][-1] * 1e6:.3f} µm; {len(its)} steps, Newton "
             f"{sum(its)} iterations (max {max(its, default=0)}), {self.wall_time_s:.1f} s"
+            + self._against_hill()
+            + (
+                f"; WARNING: the coarse model outside the patch reached "
+                f"{self.max_coarse_yield_ratio:.2f} σy (the plastic zone outgrew the patch)"
+                if self.max_coarse_yield_ratio > 1.0
+                else ""
+            )
         )
+
+    def _against_hill(self) -> str:
+        ref, h = self.reference, self.history
+        if "outer_displacement" not in ref:
+            return ""
+        c = h["plastic_radius"][-1] / ref["plastic_radius"] - 1.0
+        ub = h["outer_displacement"][-1] / ref["outer_displacement"] - 1.0
+        return f"; against Hill: c {100 * c:+.2f}%, u_b {100 * ub:+.2f}%"

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ...contract import SimulationError
+from ...contract import CoarseYieldWarning, SimulationError
 from ...io import QuasiStaticRunWriter, ResultsFolder, read_checkpoint, write_checkpoint
 from ...solvers import solve_quasi_static
 from .hill import (
@@ -30,10 +30,6 @@ if TYPE_CHECKING:  # annotations only: the configuration runs this module
     from .config import PressureVesselConfig
 
 __all__ = ["CHECKPOINT", "CoarseYieldWarning", "resume", "run"]
-
-
-class CoarseYieldWarning(UserWarning):
-    """The coarse elastic model carries stresses above the yield stress outside the patch."""
 
 
 logger = logging.getLogger(__name__)
@@ -195,14 +191,21 @@ def run(config: PressureVesselConfig, out: str | None = None,
         first_yield = _first_yield(config, setup)
     listeners = _listeners(config, setup, folder, recorder, first_yield, progress, restore)
     try:
-        qs = solve_quasi_static(
-            setup.problem, load=1.0, steps=config.steps, on_step=listeners, adapt=setup.adapt,
-            restore=None if restore is None else restore["solver"],
-        )  # fmt: skip
+        with warnings.catch_warnings():  # the demo says it itself, with the run's figure
+            warnings.simplefilter("ignore", CoarseYieldWarning)
+            qs = solve_quasi_static(
+                setup.problem, load=1.0, steps=config.steps, on_step=listeners,
+                adapt=setup.adapt, restore=None if restore is None else restore["solver"],
+            )  # fmt: skip
     except SimulationError as err:  # a Newton failure, the patch's cap
         if folder is not None:
             folder.add_results({"history": recorder.history})
             folder.finish("failed", str(err))
+        raise
+    except KeyboardInterrupt:  # every converged step is on disk, with its checkpoint
+        if folder is not None:
+            folder.add_results({"history": recorder.history})
+            folder.finish("interrupted", f"interrupted: continue with --resume --out {out}")
         raise
     result = _result(config, setup, qs, recorder, first_yield, time.perf_counter() - start)
     if folder is not None:
