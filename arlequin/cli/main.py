@@ -12,6 +12,7 @@ import argparse
 import logging
 import os
 import sys
+import warnings
 from collections.abc import Sequence
 
 from .. import __version__
@@ -54,6 +55,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
+    # a warning as one line naming its kind (Python's default shows a source line, which reads
+    # like a crash)
+    warnings.formatwarning = lambda message, category, *_, **__: (
+        f"warning ({category.__name__}): {message}\n"
+    )
     if args.verbose:  # the library's own messages, not scikit-fem's or numba's internals
         logging.getLogger("arlequin").setLevel(logging.INFO)
     try:

@@ -75,7 +75,7 @@ class PlateWithHoleResult(JsonResult):
         return (
             f"plate with a hole ({self.config.get('model')}): first yield "
             f"{self.first_yield_load / 1e6:.2f} MPa, S = {h['load'][-1] / 1e6:.2f} MPa: edge "
-            f"displacement {h['displacement'][-1] * 1e6:.4f} um, plastic area "
+            f"displacement {h['displacement'][-1] * 1e6:.4f} µm, plastic area "
             f"{h['plastic_area'][-1] * 1e6:.4f} mm^2, extent {h['plastic_extent'][-1] / a:.3f} a; "
             f"{len(its)} steps, Newton {sum(its)} iterations (max {max(its, default=0)}), "
             f"{self.n_elements} cells, {self.wall_time_s:.1f} s ({self.status})"

@@ -96,7 +96,7 @@ def plot_plastic_zone(setup: VesselSetup, state: Any, path: str) -> None:
     ax.autoscale()
     ax.set_aspect("equal")
     fig.colorbar(coll, ax=ax, label="equivalent plastic strain")
-    ax.set_title("plastic zone (patch or fine mesh) over the coarse mesh")
+    ax.set_title("plastic zone over the coarse mesh", fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
