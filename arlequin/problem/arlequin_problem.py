@@ -388,18 +388,21 @@ class ArlequinProblem:
         )
         return FieldLayout([coarse, *blocks], multipliers)
 
-    def coarse_yield_ratio(self, u: np.ndarray) -> float | None:
+    def coarse_yield_ratio(self, u: np.ndarray, yield_stress: float | None = None) -> float | None:
         """The largest von Mises stress of the coarse model outside every patch over the
-        smallest initial yield stress of the patches' materials, at the global displacement
-        ``u`` (m); None when the coarse model gives no stress (``stress_at_quadrature``) or no
-        patch a yield stress (``yield_stress``, :class:`arlequin.contract.SupportsCellStates`).
-        Above 1, the plastic zone has outgrown the patches."""
+        smallest initial yield stress of the patches' materials (or ``yield_stress``, Pa), at
+        the global displacement ``u`` (m); None when the coarse model gives no stress
+        (``stress_at_quadrature``) or no yield stress is known (given, or a patch model's
+        ``yield_stress``, :class:`arlequin.contract.SupportsCellStates`). Above 1, the plastic
+        zone has outgrown the patches."""
         stress = getattr(self.coarse, "stress_at_quadrature", None)
         yields = [
             float(np.min(p.model.yield_stress(None)))
             for p in self.patches
             if callable(getattr(p.model, "yield_stress", None))
         ]
+        if yield_stress is not None:
+            yields = [float(yield_stress)]
         if stress is None or not yields:
             return None
         outside = np.ones(self.coarse.mesh.nelements, dtype=bool)

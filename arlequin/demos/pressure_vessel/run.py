@@ -105,17 +105,8 @@ class _Recorder:
         ``mono``): above 1, the coarse model carries stresses the material cannot."""
         if self.setup.plastic_block == "coarse":
             return 0.0
-        problem = self.setup.problem
-        coarse = problem.coarse
-        u = solver.u[solver.system.dofmap["coarse"].slice]
-        outside = np.ones(coarse.mesh.nelements, dtype=bool)
-        outside[problem.couplings[0].overlap.coarse_cells] = False  # the patch's coarse cells
-        if not np.any(outside):
-            return 0.0
-        s = coarse.stress_at_quadrature(u)[:, :, outside]
-        dev = s - np.einsum("ii...->...", s)[None, None] / 3.0 * np.eye(3)[:, :, None, None]
-        vm = np.sqrt(1.5 * np.einsum("ij...,ij...->...", dev, dev))
-        return float(vm.max() / self.config.yield_stress)
+        ratio = self.setup.problem.coarse_yield_ratio(solver.u, self.config.yield_stress)
+        return 0.0 if ratio is None else ratio
 
 
 def _bore_area(setup: VesselSetup, a: float) -> float:
