@@ -1,5 +1,5 @@
 """What the commands of the ``arlequin`` CLI share: the results check, JSON output, ``--out``,
-the progress bar and a demo's run (``run_demo``)."""
+the progress bar."""
 
 from __future__ import annotations
 
@@ -9,7 +9,6 @@ import json
 import math
 import os
 from collections.abc import Callable, Iterator
-from typing import Any
 
 __all__ = [
     "NonFiniteResult",
@@ -17,7 +16,6 @@ __all__ = [
     "add_out",
     "check_writable",
     "progress_bar",
-    "run_demo",
     "write_json",
 ]
 
@@ -119,17 +117,6 @@ class ProgressBar:
         """Close the bar (if it was opened)."""
         if self.bar is not None:
             self.bar.close()
-
-
-def run_demo(run: Callable[..., Any], options: dict, args: Any, label: str) -> Any:
-    """A demo's command: ``run(out=args.out, progress=..., **options)`` under a percent
-    progress bar (none with ``args.quiet``), its summary line printed and its JSON written to
-    ``args.json``; returns the result."""
-    with progress_bar(100.0, "%", args.quiet, scale=100.0, label=label) as update:
-        result = run(out=args.out, progress=update, **options)
-    print(result.summary())
-    write_json(args.json, result.to_json())
-    return result
 
 
 @contextlib.contextmanager

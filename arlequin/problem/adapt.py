@@ -48,7 +48,7 @@ from ..coupling.fields import evaluate_field
 from ..coupling.patches import refine_region
 from ..geometry.locate import cell_centroids
 from ..geometry.reference import scalar_element_for
-from .arlequin_problem import ArlequinProblem
+from .arlequin_problem import ArlequinProblem, von_mises_of
 
 __all__ = [
     "AdaptView",
@@ -165,12 +165,6 @@ class Growth:
 
     cells: np.ndarray
     reject: bool
-
-
-def von_mises_of(sigma: np.ndarray) -> np.ndarray:
-    """√(3/2) ‖dev σ‖ (Pa) of tensors (3, 3, …)."""
-    dev = sigma - np.einsum("ii...->...", sigma)[None, None] / 3.0 * np.eye(3)[:, :, None, None]
-    return np.sqrt(1.5 * np.einsum("ij...,ij...->...", dev, dev))
 
 
 def _rings(mesh: Any, mask: np.ndarray, rings: int) -> np.ndarray:

@@ -29,7 +29,7 @@ from ..geometry.locate import cell_centroids, locate_points
 from ..io.layout import BlockFields, FieldLayout
 from .system import Block, BlockTerm, CoupledSystem, LinearConstraint
 
-__all__ = ["ArlequinProblem", "Patch", "PatchCoupling"]
+__all__ = ["ArlequinProblem", "Patch", "PatchCoupling", "von_mises_of"]
 
 logger = logging.getLogger(__name__)
 
@@ -55,6 +55,12 @@ class _Dirichlet:
     value: Any
     amplitude: Callable[[float], float] | None
     level: str
+
+
+def von_mises_of(sigma: np.ndarray) -> np.ndarray:
+    """√(3/2) ‖dev σ‖ (Pa) of tensors (3, 3, …)."""
+    dev = sigma - np.einsum("ii...->...", sigma)[None, None] / 3.0 * np.eye(3)[:, :, None, None]
+    return np.sqrt(1.5 * np.einsum("ij...,ij...->...", dev, dev))
 
 
 @dataclass
@@ -410,9 +416,7 @@ class ArlequinProblem:
             outside[pc.overlap.coarse_cells] = False
         if not outside.any():
             return 0.0
-        s = stress(u[self.dofmap()["coarse"].slice])[:, :, outside]
-        dev = s - np.einsum("ii...->...", s)[None, None] / 3.0 * np.eye(3)[:, :, None, None]
-        vm = np.sqrt(1.5 * np.einsum("ij...,ij...->...", dev, dev))
+        vm = von_mises_of(stress(u[self.dofmap()["coarse"].slice])[:, :, outside])
         return float(vm.max() / min(yields))
 
     def mediator_rows(self, pc: PatchCoupling) -> np.ndarray:

@@ -7,15 +7,15 @@ from typing import Any
 
 import numpy as np
 
+from ...problem.arlequin_problem import von_mises_of
+
 __all__ = ["bore_value", "plastic_radius", "radial_profile", "von_mises"]
 
 
 def von_mises(state: Any) -> np.ndarray:
     """The von Mises stress (Pa) at the quadrature points of a J2 state, (n_elems, n_qp)."""
     if hasattr(state, "cauchy"):  # finite strain: the Cauchy stress of the last evaluation
-        s = state.cauchy
-        dev = s - np.einsum("ii...->...", s)[None, None] / 3.0 * np.eye(3)[:, :, None, None]
-        return np.sqrt(1.5 * np.einsum("ij...,ij...->...", dev, dev))
+        return von_mises_of(state.cauchy)
     return np.asarray(state.von_mises)
 
 
