@@ -10,12 +10,19 @@ factorisation and the solves of the Newton systems, the rest), the largest Newto
 r_k+1 / r_k² below 1e-3, the accuracy against mono, and each model's peak traced memory (one
 more run under :mod:`tracemalloc`).
 
+``newton``: one more run of each model under :func:`_newton.newton_record`, item 5's
+contraction constants C = r_k+1 / r_k² (below r_k = 1e-3) split into the iterations where the
+plastic set stayed fixed and those where quadrature points crossed the yield surface, with
+each step's C and crossings; ``newton_by_hardening``: the same split for the Arlequin run
+with a linear hardening modulus H of 0, E/1000, E/100 and E/10 (perfect plasticity is not
+what makes C large). ``--no-newton`` skips them.
+
 The coarse elastic plate has fewer free dofs than a quarter of the patch's, so the quasi-static
 solver does not condense it (:data:`arlequin.solvers.condensation.MIN_LINEAR_SHARE`): the
 Arlequin run is also timed with the condensation forced (that share set to 0),
 ``arlequin_condensed``, to show what condensing would give.
 
-    python benchmarks/plate_with_hole.py [--levels 3] [--steps 10] [--repeat 1]
+    python benchmarks/plate_with_hole.py [--levels 3] [--steps 10] [--repeat 1] [--no-newton]
 """
 
 from __future__ import annotations
@@ -30,6 +37,7 @@ from contextlib import contextmanager
 import _threads  # before numba runs: OpenMP threads sleep between parallel regions
 import numpy as np
 import scipy.sparse.linalg as spla
+from _newton import contraction_summary, newton_record
 
 from arlequin.demos.plate_with_hole import run_plate_with_hole
 from arlequin.models import SmallStrainJ2
@@ -107,7 +115,26 @@ def max_contraction(residuals) -> float:
     return worst
 
 
-def bench(levels: int, steps: int, repeat: int, memory: bool) -> dict:
+def newton_diagnostics(levels: int, steps: int) -> dict:
+    """Item 5's contraction constants of each model, split by plastic-set changes, and of the
+    Arlequin run against the hardening modulus."""
+    out: dict = {"models": {}, "hardening": {}}
+    for model in MODELS:
+        with newton_record() as records:
+            run_plate_with_hole(model=model, levels=levels, steps=steps)
+        out["models"][model] = contraction_summary(records)
+    young = 210e9  # the demo's default E (Pa)
+    for fraction in (0.0, 1e-3, 1e-2, 1e-1):
+        with newton_record() as records:
+            run_plate_with_hole(model="arlequin", levels=levels, steps=steps,
+                                hardening=fraction * young)  # fmt: skip
+        summary = contraction_summary(records)
+        summary.pop("steps")
+        out["hardening"][f"H={fraction:g}E"] = summary
+    return out
+
+
+def bench(levels: int, steps: int, repeat: int, memory: bool, newton: bool = True) -> dict:
     out: dict = {"levels": levels, "steps": steps, "repeat": repeat, "models": {}}
     out["threads"] = _threads.settings()
     results = {}
@@ -156,6 +183,10 @@ def bench(levels: int, steps: int, repeat: int, memory: bool) -> dict:
         out["models"]["arlequin_condensed"]["wall_time_s"] / t["arlequin"]
     )
     out["targets"] = {"T_mono_over_T_arlequin": ">= 10", "T_arlequin_over_T_graded": "<= 1.5"}
+    if newton:
+        diagnostics = newton_diagnostics(levels, steps)
+        out["newton"] = diagnostics["models"]
+        out["newton_by_hardening"] = diagnostics["hardening"]
     return out
 
 
@@ -165,8 +196,13 @@ def main(argv=None) -> dict:
     parser.add_argument("--steps", type=int, default=10)
     parser.add_argument("--repeat", type=int, default=1)
     parser.add_argument("--no-memory", action="store_true", help="skip the tracemalloc runs")
+    parser.add_argument(
+        "--no-newton",
+        action="store_true",
+        help="skip the Newton diagnostics (item 5's C by plastic-set changes)",
+    )
     args = parser.parse_args(argv)
-    out = bench(args.levels, args.steps, args.repeat, not args.no_memory)
+    out = bench(args.levels, args.steps, args.repeat, not args.no_memory, not args.no_newton)
     print(json.dumps(out, indent=2))
     return out
 
