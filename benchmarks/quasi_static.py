@@ -16,7 +16,14 @@ every iteration): ``condensation_saving`` is T(condense=False)/T(condense=True).
 assembly rate is the quadrature points per second of ``SmallStrainJ2.tangent`` in a plastic
 state (2D and 3D). Peak memory: the process's resident peak after each case.
 
-    python benchmarks/quasi_static.py [--repeat 2] [--dim3] [--dim3-fine 0.00625]
+``--limit-load`` adds ``cylinder_limit_load``: the plane-strain ``mono`` cylinder of item 4
+pressed to 240 MPa in 12 steps (it stops at its limit load, 192.09 MPa) and driven by the
+bore's displacement to 1 mm, under :func:`_newton.newton_record`: per converged step item 5's
+contraction constants C = r_k+1 / r_k² (below r_k = 1e-3) with the number of quadrature points
+that crossed the yield surface in each iteration, and the smallest eigenvalue of the converged
+tangent over the elastic one (C grows as it falls toward the limit point). Several minutes.
+
+    python benchmarks/quasi_static.py [--repeat 2] [--dim3] [--dim3-fine 0.00625] [--limit-load]
 
 Prints JSON.
 """
@@ -155,12 +162,37 @@ def tangent_rate(dim: int) -> dict:
             "points_per_second": round(n_qp / best)}  # fmt: skip
 
 
+def cylinder_limit_load() -> dict:
+    """The mono cylinder pressed past its limit load and driven by the bore's displacement:
+    Newton's contraction constants and the tangent's smallest eigenvalue per step."""
+    from _newton import contraction_summary, newton_record
+
+    from arlequin.demos.pressure_vessel import run_pressure_vessel
+
+    drives = {"pressure": ({"pressure": 2.4e8, "steps": 12}, 2.4e8, "Pa"),
+              "bore_displacement": ({"inner_displacement": 1e-3}, 1e-3, "m")}  # fmt: skip
+    out = {}
+    for drive, (options, scale, unit) in drives.items():
+        with newton_record(eigenvalues=True) as records:
+            r = run_pressure_vessel(shape="cylinder", model="mono", **options)
+        summary = contraction_summary(records)
+        summary["load_at_factor_1"], summary["load_unit"] = scale, unit
+        summary["limit_load_Pa"] = r.limit_load if r.limit_load_reached else None
+        out[drive] = summary
+    return out
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--repeat", type=int, default=1, help="rounds; each case's shortest")
     parser.add_argument("--dim3", action="store_true", help="also the 3D eighth of the sphere")
     parser.add_argument("--dim3-coarse", type=float, default=0.1 / 6, help="3D coarse size (m)")
     parser.add_argument("--dim3-fine", type=float, default=0.1 / 24, help="3D fine size (m)")
+    parser.add_argument(
+        "--limit-load",
+        action="store_true",
+        help="also Newton's contraction near the cylinder's limit load",
+    )
     args = parser.parse_args()
     cases = [("arlequin", 2, True, {}), ("arlequin", 2, False, {}), ("mono", 2, True, {})]
     if args.dim3:
@@ -181,6 +213,8 @@ def main() -> None:
             out[f"condensation_saving_{dim}d"] = round(f["wall_time_s"] / a["wall_time_s"], 3)
         if a and m:
             out[f"T_mono_over_T_arlequin_{dim}d"] = round(m["wall_time_s"] / a["wall_time_s"], 3)
+    if args.limit_load:
+        out["cylinder_limit_load"] = cylinder_limit_load()
     print(json.dumps(out, indent=1))
 
 

@@ -235,6 +235,22 @@ def test_cylinder_first_yield_limit_load_and_plateau():
     driven = run_pressure_vessel(shape="cylinder", model="mono", inner_displacement=1e-3)
     assert driven.history["pressure"][-1] == pytest.approx(limit, rel=0.01)
     assert driven.history["pressure"][-2] == pytest.approx(limit, rel=0.01)  # a plateau
+    # item 5 wherever the tangent is regular (docs/quasi_static.md): every step of the runs to
+    # 180 MPa and of the displacement-driven run (largest r_k+1 / r_k² below 1e-3 measured
+    # 0.17 on mono); the pressure-driven steps beyond 180 MPa exceed the factor 10, as the
+    # tangent turns singular at the limit point (C about 0.008 / its smallest eigenvalue
+    # relative to the elastic one: 180 at 4.9e-5, 192.09 MPa): not asserted
+    pressed_regular = [
+        res
+        for p, res in zip(pressed.history["pressure"], pressed.history["residuals"])
+        if p <= 1.8e8 * (1.0 + 1e-9)
+    ]
+    for residuals in (mono.history["residuals"], arl.history["residuals"],
+                      driven.history["residuals"], pressed_regular):  # fmt: skip
+        for res in residuals:
+            for r0, r1 in itertools.pairwise(res):
+                if r0 < 1e-3 and r1 > 1e-10:
+                    assert r1 <= 10.0 * r0**2, res
 
 
 @pytest.mark.slow
