@@ -167,7 +167,7 @@ def test_default_configuration_meets_item_6():
     "(2e-5 to 7e-3 sigma_y from yield at the solution) cross the yield surface, against at "
     "most 4.9 and 10.9 where the plastic set stays fixed; the tangent is exact "
     "(test_assembled_tangent_is_the_derivative_of_the_assembled_force), the line search never "
-    "cuts, hardening does not lower C (benchmarks/plate_with_hole.py: newton, "
+    "cuts, hardening (E/1000 to E/10) leaves C over 10 (benchmarks/plate_with_hole.py: newton, "
     "newton_by_hardening; docs/plate_with_hole.md, Newton)",
 )
 def test_default_configuration_newton_quadratic():
