@@ -202,13 +202,15 @@ def run(config: PressureVesselConfig, out: str | None = None,
             )  # fmt: skip
     except SimulationError as err:  # a Newton failure, the patch's cap
         if folder is not None:
-            folder.add_results({"history": recorder.history})
+            folder.add_results(_so_far(recorder, setup))
             folder.finish("failed", str(err))
         raise
     except KeyboardInterrupt:  # every converged step is on disk, with its checkpoint
         if folder is not None:
-            folder.add_results({"history": recorder.history})
-            folder.finish("interrupted", f"interrupted: continue with --resume --out {out}")
+            folder.add_results(_so_far(recorder, setup))
+            folder.finish("interrupted", "interrupted: every converged step is kept; an adaptive "
+                          "run has no checkpoint, run it again" if setup.adapt is not None
+                          else f"interrupted: continue with --resume --out {out}")  # fmt: skip
         raise
     result = _result(config, setup, qs, recorder, first_yield, time.perf_counter() - start)
     if folder is not None:
@@ -219,6 +221,15 @@ def run(config: PressureVesselConfig, out: str | None = None,
         folder.finish("complete", qs.message)
     logger.info("%s", result.summary())
     return result
+
+
+def _so_far(recorder: _Recorder, setup: VesselSetup) -> dict[str, Any]:
+    """The results of the converged steps so far (a stopped run's results.json): the history,
+    and the growths of an adaptive patch."""
+    out: dict[str, Any] = {"history": recorder.history}
+    if setup.adapt is not None:
+        out["adaptations"] = [a.to_json() for a in setup.adapt.records]
+    return out
 
 
 def _listeners(config, setup, folder, recorder, first_yield, progress, restore) -> list:
@@ -238,6 +249,9 @@ def _listeners(config, setup, folder, recorder, first_yield, progress, restore) 
         listeners.append(writer)
         if setup.adapt is not None:
             listeners.append(AdaptationPictures(folder, setup))
+            # no checkpoint (the grown problem is not in it): results.json after every step,
+            # so that a hard stop keeps the history of every converged step on disk
+            listeners.append(lambda solver: folder.add_results(_so_far(recorder, setup)))
         else:
             path = folder.path / CHECKPOINT
 
