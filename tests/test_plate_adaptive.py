@@ -22,6 +22,29 @@ from arlequin.demos.plate_with_hole import PlateWithHoleConfig, run_plate_with_h
 SMALL = {"levels": 1, "steps": 3}
 
 
+def test_fill_corners_leaves_no_re_entrant_corner():
+    """The closure of the plate's adaptive patch: an L of three grid cells becomes their 2 × 2
+    square (the corner cell shares an edge with two of them); a straight row stays as it is;
+    the result has no cell outside sharing an edge with two inside."""
+    from arlequin.demos.plate_with_hole.meshes import plate_mesh
+    from arlequin.demos.plate_with_hole.setup import fill_corners
+
+    mesh, _ = plate_mesh(0.01, 4, 4, 0.1, 0.02)
+    centre = mesh.p[:, mesh.t].mean(axis=1) / 0.0025  # in quarter hole radii (a/4)
+
+    def cell(i, j):  # the grid cell of centre ((2i + 1) a/4, (2j + 1) a/4), beyond 2a
+        return int(np.argmin(np.hypot(centre[0] - (2 * i + 1), centre[1] - (2 * j + 1))))
+
+    closure = fill_corners(mesh)
+    mask = np.zeros(mesh.nelements, dtype=bool)
+    mask[[cell(10, 0), cell(11, 0), cell(10, 1)]] = True
+    closed = closure(mask)
+    assert set(np.nonzero(closed)[0]) == {cell(10, 0), cell(11, 0), cell(10, 1), cell(11, 1)}
+    row = np.zeros(mesh.nelements, dtype=bool)
+    row[[cell(10, 0), cell(11, 0), cell(12, 0)]] = True
+    assert np.array_equal(closure(row), row)
+
+
 def test_adaptive_plate_grows_and_reports(tmp_path):
     """One level, 3 steps to 195 MPa from the one-ring seed. Measured: three growths, after
     step 2 (the first step past yield: rejected, plastic flow in the seed's band, to 0.0198 of
