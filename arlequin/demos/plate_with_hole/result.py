@@ -101,4 +101,10 @@ class PlateWithHoleResult(JsonResult):
             f"{h['plastic_area'][-1] * 1e6:.4f} mm^2, extent {h['plastic_extent'][-1] / a:.3f} a; "
             f"{len(its)} steps, Newton {sum(its)} iterations (max {max(its, default=0)}), "
             f"{self.n_elements} cells, {self.wall_time_s:.1f} s ({self.status})"
+            + (
+                f"; the patch grew {len(self.adaptations)} times to {self.patch_fraction:.3f} "
+                f"of the plate, coarse σ_vm/σy ≤ {self.max_coarse_yield_ratio:.3f}"
+                if self.adaptations
+                else ""
+            )
         )
