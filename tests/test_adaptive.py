@@ -207,6 +207,29 @@ def test_adaptive_sphere_cap_stops_the_run_with_the_steps_on_disk(tmp_path):
     meta = json.loads((tmp_path / "results.json").read_text())
     assert meta["status"] == "failed"
     assert len(read_history(tmp_path / "newton.csv")["load_factor"]) == 3
+    # results.json: the unloaded vessel and the three steps (written after every step)
+    assert len(meta["results"]["history"]["value"]["pressure"]) == 4
+
+
+def test_adaptive_sphere_interrupted_keeps_every_step_on_disk(tmp_path):
+    """Ctrl-C after the second converged step (raised by the progress callback): the folder
+    marked interrupted, results.json with the unloaded vessel and the two steps."""
+    import json
+
+    from arlequin.demos.pressure_vessel import run_pressure_vessel
+
+    calls = []
+
+    def progress(fraction: float) -> None:
+        calls.append(fraction)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        run_pressure_vessel(adaptive=True, out=str(tmp_path), progress=progress, **SMALL)
+    meta = json.loads((tmp_path / "results.json").read_text())
+    assert meta["status"] == "interrupted"
+    assert len(meta["results"]["history"]["value"]["pressure"]) == 3
 
 
 @pytest.mark.parametrize(

@@ -58,6 +58,7 @@ __all__ = [
     "IndicatorError",
     "NonNestedPatchError",
     "PatchLimitError",
+    "cell_rings",
 ]
 
 logger = logging.getLogger(__name__)
@@ -99,7 +100,14 @@ class Adaptation:
     newton_iterations : int
         Iterations of that re-solve.
     wall_time_s : float
-        Time spent rebuilding and transferring (s), the re-solve excluded.
+        Time spent rebuilding the patch (its mesh, model, overlap, weights, gluing band,
+        coupling rows) and transferring the fields (s).
+    system_time_s : float
+        Time the solver spent on the new system's operators and saddle-point solver (s).
+    resolve_time_s : float
+        Time of the re-solve of the multipliers and fields at the same load (s).
+    discarded_time_s : float
+        Time of the rejected step computed again after the growth (s; 0 if accepted).
     """
 
     step: int
@@ -111,6 +119,15 @@ class Adaptation:
     energy_jump: float | None = None
     newton_iterations: int = 0
     wall_time_s: float = 0.0
+    system_time_s: float = 0.0
+    resolve_time_s: float = 0.0
+    discarded_time_s: float = 0.0
+
+    @property
+    def adapt_time_s(self) -> float:
+        """The growth's whole cost (s): rebuild, transfer, new operators, re-solve and the
+        rejected step's time."""
+        return self.wall_time_s + self.system_time_s + self.resolve_time_s + self.discarded_time_s
 
     def to_json(self) -> dict[str, Any]:
         """The adaptation as plain JSON (an entry of the demos' ``adaptations``)."""
@@ -122,6 +139,10 @@ class Adaptation:
             "energy_jump": self.energy_jump,
             "rejected": self.rejected,
             "newton_iterations": self.newton_iterations,
+            "rebuild_time_s": self.wall_time_s,
+            "system_time_s": self.system_time_s,
+            "resolve_time_s": self.resolve_time_s,
+            "discarded_time_s": self.discarded_time_s,
         }
 
 
@@ -167,7 +188,7 @@ class Growth:
     reject: bool
 
 
-def _rings(mesh: Any, mask: np.ndarray, rings: int) -> np.ndarray:
+def cell_rings(mesh: Any, mask: np.ndarray, rings: int) -> np.ndarray:
     """``mask`` of cells grown by ``rings`` layers of cells sharing a node with it."""
     out = mask.copy()
     for _ in range(int(rings)):
@@ -361,7 +382,7 @@ class AdaptivePatch:
         flags &= outside
         if not flags.any():
             return None
-        grown = _rings(self.problem.coarse.mesh, flags, self.buffer) | ~outside
+        grown = cell_rings(self.problem.coarse.mesh, flags, self.buffer) | ~outside
         if self.closure is not None:
             closed = np.asarray(self.closure(grown.copy()), dtype=bool)
             if closed.shape != grown.shape or np.any(grown & ~closed):
@@ -397,7 +418,7 @@ class AdaptivePatch:
         band = np.zeros(fmesh.nelements, dtype=bool)
         band[pc.fine_gluing_cells] = True
         plastic = ep.max(axis=1) > 0.0
-        near = _rings(fmesh, band, self.band_cells) & plastic
+        near = cell_rings(fmesh, band, self.band_cells) & plastic
         if not near.any():
             return np.zeros(outside.size, dtype=bool), False
         parent = np.empty(fmesh.nelements, dtype=np.int64)
@@ -407,7 +428,7 @@ class AdaptivePatch:
         # the nearest cells outside: the parents' rings out to the patch's boundary
         cmesh = self.problem.coarse.mesh
         for _ in range(2 + self.band_cells // 2**self.levels):
-            touched = _rings(cmesh, touched, 1)
+            touched = cell_rings(cmesh, touched, 1)
             if (touched & outside).any():
                 break
         return touched & outside, bool(plastic[band].any())

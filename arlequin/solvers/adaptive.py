@@ -8,12 +8,15 @@ with them (``replace_system``) and re-solves the multipliers by Newton at the sa
 (``resolve``). A *rejected* step (the coarse model yields outside the patch) is first undone
 (``restore``): the patch grows from the committed state and the step is computed again. Each
 growth records the relative jump of the total stored energy across it and the iterations of the
-re-solve; listeners with an ``on_adapt(solver, adapt)`` member (the results writers) hear of it.
+re-solve, and the time of its parts (:class:`~arlequin.problem.adapt.Adaptation`: the rebuild and
+the transfer, the solver's new operators, the re-solve, the rejected step's); listeners with an
+``on_adapt(solver, adapt)`` member (the results writers) hear of it.
 """
 
 from __future__ import annotations
 
 import logging
+import time
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -73,17 +76,22 @@ class AdaptableSolver:
         return None if self._previous is None else (self._previous[0], self._previous[2])
 
 
-def _grow(solver: Any, adapt: Any, growth: Any, step: int, listeners: Sequence[Any]) -> None:
+def _grow(solver: Any, adapt: Any, growth: Any, step: int, listeners: Sequence[Any],
+          discarded: float = 0.0) -> None:  # fmt: skip
     before = solver.stored_energy()
     previous = solver.previous
     problem, u, states = adapt.grow(growth, solver.u, solver.states, step, solver.t)
     if previous is not None:  # the next step's predictor: the last increment, moved too
         previous = (adapt.transfer_displacement(previous[0]), previous[1])
+    start = time.perf_counter()
     solver.replace_system(problem, u, states)
+    system = time.perf_counter()
     iterations = solver.resolve(previous)
     after = solver.stored_energy()
     record = adapt.records[-1]
     record.newton_iterations = iterations
+    record.system_time_s, record.resolve_time_s = system - start, time.perf_counter() - system
+    record.discarded_time_s = discarded
     record.energy_jump = (after - before) / abs(before) if before else 0.0
     logger.info("patch grown: stored energy %.6g -> %.6g J (jump %.3g), %d Newton iterations",
                 before, after, record.energy_jump, iterations)  # fmt: skip
@@ -125,14 +133,16 @@ def run_adaptive(
     while solver.status == "running":
         snap = solver.snapshot()
         try:
+            start = time.perf_counter()
             rec = solver.step()
             if rec is None:  # a limit load
                 break
             step = len(solver.history)
             growth = adapt.assess(solver, step)
             if growth is not None and growth.reject:
+                discarded = time.perf_counter() - start  # the step and its assessment
                 solver.restore(snap)
-                _grow(solver, adapt, growth, step, on_step)
+                _grow(solver, adapt, growth, step, on_step, discarded)
                 continue
             for listener in on_step:
                 listener(solver)

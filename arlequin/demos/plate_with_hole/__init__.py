@@ -23,6 +23,10 @@ shared cores): mono 61.7 s, arlequin 5.2 s, graded 9.1 s: T_mono / T_arlequin = 
 SuperLU factorisation of its Newton systems (the coarse plate, 880 dofs for the patch's 8496,
 is not condensed: forcing it changes nothing measurable).
 
+``adaptive``: the patch starts from the coarse ring on the hole and grows where the plastic
+zone nears its gluing band or the coarse stress reaches β σy (default β 0.9), closed over
+re-entrant corners (:func:`.setup.fill_corners`); see ``docs/plate_with_hole.md``.
+
 Outputs (``out``): results.json (inputs and results with units), ``newton.csv`` (per step:
 load factor, Newton iterations, residuals, cuts), the field series of each block
 (``fields/coarse.xdmf``, ``fields/patch0.xdmf``: displacement, α, the mediator's multipliers,

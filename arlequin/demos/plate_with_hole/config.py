@@ -85,6 +85,22 @@ class PlateWithHoleConfig(DemoConfig):
         None, "the patch: the coarse cells within the square [0, RP]^2 (RP snapped down to a "
         "grid line)", "m", metavar="RP", default_help="3.5a",
     )  # fmt: skip
+    adaptive: bool = option(
+        False, "adaptive patch: a seed of the coarse ring at the hole that grows where the "
+        "material nears yield (--model arlequin)", "",
+    )  # fmt: skip
+    # 0.9, not the library's 0.8: at the default load the elastic ligament above the hole
+    # carries 0.8 σy (net section, plane strain), and β = 0.8 grows the patch along all of it
+    adapt_threshold: float = option(0.9, "coarse cells whose von Mises stress reaches BETA σy "
+                                    "join the patch", "1", metavar="BETA")  # fmt: skip
+    adapt_buffer: int = option(1, "rings of coarse cells added around the flagged ones", "1",
+                               metavar="RINGS")  # fmt: skip
+    adapt_every: int = option(1, "evaluate the indicator every N load steps (the yield check "
+                              "every step)", "1", metavar="N")  # fmt: skip
+    max_patch_fraction: float = option(
+        0.5, "largest share of the plate the adaptive patch may cover (beyond: the run stops)",
+        "1", metavar="F",
+    )  # fmt: skip
 
     # -- resolved values ---------------------------------------------------------------------
     @property
@@ -121,7 +137,8 @@ class PlateWithHoleConfig(DemoConfig):
         check_positive("patch_radius", self.patch_radius, "m", allow_none=True)
         check_range("edge_weight", self.edge_weight, 1e-3, 1.0, closed="(]")
         _count("gluing_rings", self.gluing_rings, 1)
-        if self.model != "mono":
+        self._check_adaptive()
+        if self.model != "mono" and not self.adaptive:
             r, h = self.patch_square, self.coarse_size
             if not self.block + self.gluing_rings * h <= r * (1.0 + 1e-12) < self.width:
                 raise ValueError(
@@ -137,6 +154,17 @@ class PlateWithHoleConfig(DemoConfig):
                     "material='finite-strain' needs the consistent tangent of FiniteStrainJ2, "
                     "which this version does not have: use material='small-strain'"
                 )
+
+    def _check_adaptive(self) -> None:
+        check_range("adapt_threshold", self.adapt_threshold, 0.0, 1.0, closed="(]")
+        _count("adapt_buffer", self.adapt_buffer, 0)
+        _count("adapt_every", self.adapt_every, 1)
+        check_range("max_patch_fraction", self.max_patch_fraction, 0.0, 1.0, closed="(]")
+        if self.adaptive and self.model != "arlequin":
+            raise ValueError(f"adaptive needs model='arlequin', got model={self.model!r}")
+        if self.adaptive and self.patch_radius is not None:
+            raise ValueError("adaptive starts from the coarse ring at the hole: give no "
+                             f"patch_radius, got patch_radius={self.patch_radius}")  # fmt: skip
 
     @property
     def block(self) -> float:

@@ -12,7 +12,14 @@ from ...io import ResultsFolder
 from .result import PlateWithHoleResult
 from .setup import PlateSetup
 
-__all__ = ["cell_fields", "plot_load_curve", "plot_plastic_zone", "write_pictures"]
+__all__ = [
+    "AdaptationPictures",
+    "cell_fields",
+    "plot_load_curve",
+    "plot_patch_size",
+    "plot_plastic_zone",
+    "write_pictures",
+]
 
 
 def _on_block_cells(setup: PlateSetup, values: np.ndarray) -> np.ndarray:
@@ -61,9 +68,9 @@ def plot_load_curve(result: PlateWithHoleResult, path: str) -> None:
     plt.close(fig)
 
 
-def plot_plastic_zone(setup: PlateSetup, state: Any, path: str, radius: float) -> None:
-    """ε̄p over the J2 model's cells at the end of the run (within 5 hole radii), the coarse
-    mesh's edges beside."""
+def plot_plastic_zone(setup: PlateSetup, state: Any, path: str, radius: float,
+                      title: str = "plastic zone (white: points with ε̄p > 0)") -> None:  # fmt: skip
+    """ε̄p over the J2 model's cells (within 5 hole radii), the coarse mesh's edges beside."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -87,7 +94,53 @@ def plot_plastic_zone(setup: PlateSetup, state: Any, path: str, radius: float) -
     ax.set_ylim(0.0, 5.0 * radius)
     ax.set_aspect("equal")
     fig.colorbar(coll, ax=ax, label="equivalent plastic strain")
-    ax.set_title("plastic zone (white: points with ε̄p > 0)")
+    ax.set_title(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+class AdaptationPictures:
+    """A listener of an adaptive run: the plastic zone over the grown patch, one picture a
+    growth (``patch_K.png``, from the fields re-solved after it)."""
+
+    def __init__(self, folder: ResultsFolder, setup: PlateSetup, radius: float) -> None:
+        self.folder, self.setup, self.radius, self.count = folder, setup, radius, 0
+
+    def __call__(self, solver: Any) -> None:
+        """Nothing after a step."""
+
+    def on_adapt(self, solver: Any, adapt: Any) -> None:
+        """A picture of the patch just grown (called by the adaptation after each growth)."""
+        self.count += 1
+        s = self.setup
+        state = solver.states[s.plastic_block][s.plastic_term]
+        rec = adapt.records[-1]
+        title = (f"growth {self.count} after step {rec.step}: {rec.patch_fraction:.3f} of the "
+                 "plate")  # fmt: skip
+        plot_plastic_zone(s, state, str(self.folder.picture(f"patch_{self.count}")),
+                          self.radius, title)  # fmt: skip
+
+
+def plot_patch_size(result: PlateWithHoleResult, path: str) -> None:
+    """The patch's and the plastic zone's shares of the plate against the remote traction."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    h = result.history
+    s = np.array(h["load"]) / 1e6
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.step(s, h["patch_fraction"], where="post", label="patch")
+    a = result.config["radius"]
+    w = result.config.get("half_width") or 10.0 * a
+    total = w * w - 0.25 * np.pi * a * a  # the quarter plate's area (m²)
+    ax.plot(s, np.array(h["plastic_area"]) / total, "o-", label="plastic zone")
+    ax.set_xlabel("remote traction S (MPa)")
+    ax.set_ylabel("share of the quarter plate's area")
+    ax.set_title(f"adaptive patch: {result.patch_fraction:.3f} of the plate at the end")
+    ax.legend()
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
@@ -97,5 +150,7 @@ def write_pictures(folder: ResultsFolder, setup: PlateSetup, qs: Any,
                    result: PlateWithHoleResult) -> None:  # fmt: skip
     """The run's pictures in its results folder."""
     plot_load_curve(result, str(folder.picture("load_displacement")))
+    if setup.adapt is not None:
+        plot_patch_size(result, str(folder.picture("patch_size")))
     state = qs.states[setup.plastic_block][setup.plastic_term]
     plot_plastic_zone(setup, state, str(folder.picture("plastic_zone")), result.config["radius"])

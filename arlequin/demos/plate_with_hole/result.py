@@ -14,7 +14,7 @@ JSON_KEYS = ("history", "wall_time_s", "n_elements", "patch_fraction")
 #: The keys of ``history``: one value per converged state (the initial state first, then
 #: first yield, then every load step). The Interface's three first.
 HISTORY_KEYS = ("load", "displacement", "plastic_area", "plastic_extent", "newton_iterations",
-                "residuals")  # fmt: skip
+                "residuals", "patch_fraction")  # fmt: skip
 UNITS = {
     "load": "Pa",
     "displacement": "m",
@@ -27,6 +27,8 @@ UNITS = {
     "n_dofs": "1",
     "patch_fraction": "1",
     "first_yield_load": "Pa",
+    "max_coarse_yield_ratio": "1",
+    "plastic_cover_fraction": "1",
 }
 
 
@@ -42,7 +44,9 @@ class PlateWithHoleResult(JsonResult):
         ``plastic_area`` the area of the quadrature-point weights with ε̄p > 0 over the quarter
         plate (m²); ``plastic_extent`` the largest distance from the hole's centre of a
         quadrature point with ε̄p > 0 (m, 0 before yield); ``newton_iterations`` and
-        ``residuals`` (each step's relative residuals; 0 and [] for the first two states).
+        ``residuals`` (each step's relative residuals; 0 and [] for the first two states);
+        ``patch_fraction`` the J2 region's share of the plate's area (the adaptive patch's
+        after the step).
     wall_time_s : float
         The run's wall time (s): meshes, models, the elastic solve, the load steps.
     n_elements : int
@@ -54,6 +58,21 @@ class PlateWithHoleResult(JsonResult):
         The remote traction S at which the first quadrature point yields (Pa).
     status : str
         The quasi-static solver's end: ``completed`` or ``limit_load``.
+    adaptations : list of dict
+        With ``adaptive``: one entry per growth of the patch, ``step`` (the load step after
+        which it grew, counted from the first after first yield), ``time`` (the load factor λ
+        of the fields it started from, S = λ load), ``n_fine_elements``, ``patch_fraction``
+        (of the plate's area), ``energy_jump`` (relative change of the stored energy across
+        it), ``rejected`` (the step computed again after it), ``newton_iterations``.
+    max_coarse_yield_ratio : float or None
+        The largest von Mises stress / σy of the coarse elastic model outside the patch over
+        the converged steps (0 for mono, None for the graded mesh).
+    plastic_cover_fraction : float or None
+        The share of the plate's area of the smallest nested patch that holds the final
+        plastic zone and its gluing band: the coarse cells over a plastic fine cell plus
+        ``gluing_rings`` layers around them (:func:`~.run.plastic_cover_fraction`; None for
+        mono and graded). The adaptive patch's ``patch_fraction`` over it measures how tight
+        the patch is.
     """
 
     history: dict[str, list[Any]]
@@ -64,6 +83,9 @@ class PlateWithHoleResult(JsonResult):
     first_yield_load: float = 0.0
     status: str = "completed"
     config: dict[str, Any] = field(default_factory=dict)
+    adaptations: list[dict[str, Any]] = field(default_factory=list)
+    max_coarse_yield_ratio: float | None = None
+    plastic_cover_fraction: float | None = None
 
     json_exclude = ("config",)
 
@@ -79,4 +101,10 @@ class PlateWithHoleResult(JsonResult):
             f"{h['plastic_area'][-1] * 1e6:.4f} mm^2, extent {h['plastic_extent'][-1] / a:.3f} a; "
             f"{len(its)} steps, Newton {sum(its)} iterations (max {max(its, default=0)}), "
             f"{self.n_elements} cells, {self.wall_time_s:.1f} s ({self.status})"
+            + (
+                f"; the patch grew {len(self.adaptations)} times to {self.patch_fraction:.3f} "
+                f"of the plate, coarse σ_vm/σy ≤ {self.max_coarse_yield_ratio:.3f}"
+                if self.adaptations
+                else ""
+            )
         )

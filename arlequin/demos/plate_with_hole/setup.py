@@ -34,9 +34,10 @@ from ...coupling.exactness import ExactnessWarning
 from ...coupling.gluing import Patch
 from ...coupling.weights import RampWeights
 from ...models import IsotropicElastic, J2Material, LinearElastic
+from ...problem.adapt import AdaptivePatch
 from ...problem.arlequin_problem import ArlequinProblem
 from ...problem.system import Block, BlockTerm, CoupledSystem
-from .meshes import graded_plate_mesh, plate_mesh, refine_projected, square_radius
+from .meshes import graded_plate_mesh, hole_nodes, plate_mesh, refine_projected, square_radius
 
 if TYPE_CHECKING:  # annotations only: the configuration runs this module
     from .config import PlateWithHoleConfig
@@ -150,6 +151,9 @@ class PlateSetup:
         The J2 region's share of the plate's area (1 for ``mono``).
     zone_cells : ndarray or None
         Graded: the zone's cells in the mesh (the J2 sub-mesh's cell k is ``zone_cells[k]``).
+    adapt : AdaptivePatch or None
+        With ``adaptive``: the patch that grows from its seed, the coarse ring at the hole
+        (refined with the hole's new nodes on the circle, as the fixed patch).
     """
 
     problem: Any
@@ -161,6 +165,16 @@ class PlateSetup:
     n_elements: int
     patch_fraction: float
     zone_cells: np.ndarray | None = None
+    adapt: AdaptivePatch | None = None
+
+    def follow(self, adapt: AdaptivePatch) -> None:
+        """After a growth: the problem, the J2 model, the cell count and the patch's share of
+        the plate of the grown patch."""
+        self.problem = adapt.problem
+        self.plastic_model = self.problem.patches[0].model
+        mesh = self.plastic_model.mesh
+        self.n_elements = int(self.coarse.nelements + mesh.nelements)
+        self.patch_fraction = area(mesh) / area(self.coarse)
 
 
 def j2_factory(config: PlateWithHoleConfig):
@@ -193,7 +207,10 @@ def build(config: PlateWithHoleConfig) -> PlateSetup:
     """The problem of ``config`` (supports, and the traction at λ = 1: the final load S)."""
     a, w, lv = config.radius, config.width, config.levels
     coarse, lines = plate_mesh(a, config.n_theta, config.n_radial, w, config.block)
-    cells = np.nonzero(square_radius(coarse) <= config.patch_square * (1.0 + 1e-12))[0]
+    if config.adaptive:  # the seed: the coarse cells on the hole (its first ring)
+        cells = np.nonzero(np.isin(coarse.t, hole_nodes(coarse, a)).any(axis=0))[0]
+    else:
+        cells = np.nonzero(square_radius(coarse) <= config.patch_square * (1.0 + 1e-12))[0]
     make_j2 = j2_factory(config)
     elastic = IsotropicElastic(config.young, config.poisson, DENSITY)
     kind = "plane_strain"
@@ -235,8 +252,52 @@ def build(config: PlateWithHoleConfig) -> PlateSetup:
         problem.add_dirichlet(name, lambda x: np.isclose(x[1], 0.0, atol=tol), components=[1])
     s = config.load
     problem.add_traction(np.array([s, 0.0]), where=lambda x: np.isclose(x[0], w, atol=tol))
+    adapt = _adaptive_patch(config, coarse, make_j2) if config.adaptive else None
     return PlateSetup(problem, plastic, block, term, loaded, coarse, int(n_el), float(fraction),
-                      zone)  # fmt: skip
+                      zone, adapt)  # fmt: skip
+
+
+def _adaptive_patch(config: PlateWithHoleConfig, coarse: Any, make_j2: Any) -> AdaptivePatch:
+    """The adaptation of the seed patch (the options of ``config``): new cells refined with the
+    hole's new nodes on the circle, as the seed."""
+    a, levels = config.radius, config.levels
+    return AdaptivePatch(
+        model_factory=make_j2,
+        levels=levels,
+        refine=lambda cells: refine_projected(coarse, levels, a, cells=cells),
+        threshold=config.adapt_threshold,
+        buffer=config.adapt_buffer,
+        # grow when the plastic zone comes within one coarse cell of the band (a load step
+        # moves the front by several fine cells: closer, it would enter the band and the step
+        # be computed again)
+        band_cells=2**levels,
+        every=config.adapt_every,
+        max_fraction=config.max_patch_fraction,
+        closure=fill_corners(coarse),
+    )
+
+
+def fill_corners(mesh: Any):
+    """The adaptive patch's closure: the coarse cells outside the patch that share an edge with
+    two or more of its cells join it, until none does (the patch then has no re-entrant
+    corner: at one, the fine model's free outer edge concentrates stress in the gluing band,
+    which yields where the coarse stress is far below yield)."""
+    f2t = mesh.f2t
+    shared = f2t[1] >= 0
+    first, second = f2t[0, shared], f2t[1, shared]
+
+    def closure(mask: np.ndarray) -> np.ndarray:
+        mask = mask.copy()
+        while True:
+            count = np.bincount(first[mask[second]], minlength=mask.size) + np.bincount(
+                second[mask[first]], minlength=mask.size
+            )
+            add = ~mask & (count >= 2)
+            if not add.any():
+                return mask
+            mask |= add
+
+    return closure
 
 
 def loaded_edge_average(setup: PlateSetup, system: Any, width: float) -> np.ndarray:

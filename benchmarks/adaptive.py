@@ -1,0 +1,208 @@
+"""Benchmark: adaptive patches (issue 31), each case adaptive / fixed patch / mono in one
+process.
+
+Cases (``--case``):
+
+``sphere``  the pressure sphere at the quasi-static issue's defaults (300 MPa in 10 steps, 8
+            coarse rings, 64 fine cells across the wall): adaptive from the one-ring seed,
+            the fixed patch to 187.5 mm (the demo's default: the ring nearest 185 mm), mono.
+            Criterion 3: c and u_b within 0.5% of the fixed patch, the coarse σ_vm/σy outside
+            the patch below 1 at every step, T_adaptive ≤ 1.3 T_fixed.
+``plate``   the plate with a hole at its defaults (195 MPa in 10 steps past first yield, 3
+            levels): adaptive from the coarse ring on the hole, the fixed patch [0, 3.5a]², mono.
+            Criterion 4: the load–displacement curve within 0.5% of mono at every state, the
+            final patch at most 1.5 times the plastic zone's coarse cells and their band ring,
+            T_mono / T_adaptive ≥ 8.
+``ball``    (the ball impact: to be added with the explicit adaptation; a function
+            ``ball_case(repeat, memory) -> dict`` registered in :data:`CASES`.)
+
+For each run: the wall time (the shortest of ``--repeat`` rounds, the three models
+alternating), the number of growths, the time spent adapting (rebuilding the patch, its
+overlap, weights, band and coupling rows, moving the fields; the solver's new operators; the
+re-solve at the same load; the rejected steps computed again) and its share of the run, the
+final patch fraction, the largest coarse σ_vm/σy outside the patch, and the peak traced memory
+(one more run under :mod:`tracemalloc`, unless ``--no-memory``). Prints JSON.
+
+    python benchmarks/adaptive.py [--case {sphere,plate,all}] [--repeat 1] [--no-memory]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+import tracemalloc
+import warnings
+from collections.abc import Callable
+
+import _threads  # before numba runs: OpenMP threads sleep between parallel regions
+import numpy as np
+
+#: The parts of a growth's time in its JSON entry (s).
+ADAPT_PARTS = ("rebuild_time_s", "system_time_s", "resolve_time_s", "discarded_time_s")
+
+
+def _timed(runs: dict[str, Callable[[], object]], repeat: int) -> tuple[dict, dict]:
+    """The runs alternating, ``repeat`` rounds: each one's last result and shortest time."""
+    results, best = {}, {}
+    for _ in range(repeat):
+        for name, fn in runs.items():
+            start = time.perf_counter()
+            results[name] = fn()
+            wall = time.perf_counter() - start
+            best[name] = min(best.get(name, np.inf), wall)
+    return results, best
+
+
+def _peak_memory(fn: Callable[[], object]) -> float:
+    """The peak traced memory of a run (MB)."""
+    tracemalloc.start()
+    try:
+        fn()
+        return tracemalloc.get_traced_memory()[1] / 1e6
+    finally:
+        tracemalloc.stop()
+
+
+def _adapt_figures(adaptations: list[dict], wall: float) -> dict:
+    """The growths' count and time (s, and as a share of the run's wall time ``wall``)."""
+    parts = {k: float(sum(a.get(k, 0.0) for a in adaptations)) for k in ADAPT_PARTS}
+    total = sum(parts.values())
+    return {
+        "n_adaptations": len(adaptations),
+        "n_rejected_steps": sum(bool(a.get("rejected")) for a in adaptations),
+        "adapt_time_s": total,
+        "adapt_time_split_s": parts,
+        "adapt_share": total / wall,
+        "energy_jumps": [a["energy_jump"] for a in adaptations],
+        "growth_steps": [a["step"] for a in adaptations],
+    }
+
+
+def _with_memory(out: dict, runs: dict, memory: bool) -> None:
+    for name, fn in runs.items():
+        if memory:
+            out[name]["peak_traced_memory_MB"] = _peak_memory(fn)
+
+
+def sphere_case(repeat: int, memory: bool) -> dict:
+    """The pressure sphere, adaptive / fixed patch / mono (criterion 3)."""
+    from arlequin.demos.pressure_vessel import run_pressure_vessel
+
+    runs = {
+        "adaptive": lambda: run_pressure_vessel(adaptive=True),
+        "fixed": lambda: run_pressure_vessel(),
+        "mono": lambda: run_pressure_vessel(model="mono"),
+    }
+    results, best = _timed(runs, repeat)
+    out: dict = {}
+    for name, r in results.items():
+        h = r.history
+        out[name] = {
+            "wall_time_s": best[name],
+            "n_elements": r.n_elements,
+            "n_dofs": r.n_dofs,
+            "patch_fraction": r.patch_fraction,
+            "plastic_radius_m": h["plastic_radius"][-1],
+            "outer_displacement_m": h["outer_displacement"][-1],
+            "first_yield_pressure_Pa": r.first_yield_pressure,
+            "max_coarse_yield_ratio": r.max_coarse_yield_ratio,
+            "newton_iterations": int(sum(h["newton_iterations"])),
+        }
+    out["adaptive"].update(_adapt_figures(results["adaptive"].adaptations, best["adaptive"]))
+    _with_memory(out, runs, memory)
+    a, f = out["adaptive"], out["fixed"]
+    out["criterion_3"] = {
+        "plastic_radius_deviation": a["plastic_radius_m"] / f["plastic_radius_m"] - 1.0,
+        "outer_displacement_deviation": a["outer_displacement_m"] / f["outer_displacement_m"] - 1.0,
+        "max_coarse_yield_ratio": a["max_coarse_yield_ratio"],
+        "T_adaptive_over_T_fixed": a["wall_time_s"] / f["wall_time_s"],
+        "targets": {
+            "deviations": "<= 0.005",
+            "max_coarse_yield_ratio": "< 1",
+            "T_adaptive_over_T_fixed": "<= 1.3",
+        },
+    }
+    out["reference"] = results["fixed"].reference
+    return out
+
+
+def _displacement_deviation(run, mono) -> float:
+    """The largest |run / mono − 1| of the loaded edge's displacement from first yield on,
+    mono's curve interpolated at the run's loads (an adaptive run probes its first yield on a
+    small fixed patch: 0.3% above mono's)."""
+    load = np.array(run.history["load"][1:])
+    ref = np.interp(load, mono.history["load"], mono.history["displacement"])
+    return float(np.abs(np.array(run.history["displacement"][1:]) / ref - 1.0).max())
+
+
+def plate_case(repeat: int, memory: bool) -> dict:
+    """The plate with a hole, adaptive / fixed patch / mono (criterion 4)."""
+    from arlequin.demos.plate_with_hole import run_plate_with_hole
+
+    runs = {
+        "adaptive": lambda: run_plate_with_hole(adaptive=True),
+        "fixed": lambda: run_plate_with_hole(),
+        "mono": lambda: run_plate_with_hole(model="mono"),
+    }
+    results, best = _timed(runs, repeat)
+    mono = results["mono"]
+    out: dict = {}
+    for name, r in results.items():
+        h = r.history
+        out[name] = {
+            "wall_time_s": best[name],
+            "n_elements": r.n_elements,
+            "n_dofs": r.n_dofs,
+            "patch_fraction": r.patch_fraction,
+            "plastic_cover_fraction": r.plastic_cover_fraction,
+            "first_yield_load_Pa": r.first_yield_load,
+            "final_displacement_m": h["displacement"][-1],
+            "final_plastic_area_m2": h["plastic_area"][-1],
+            "final_plastic_extent_m": h["plastic_extent"][-1],
+            "max_coarse_yield_ratio": r.max_coarse_yield_ratio,
+            "max_displacement_deviation_from_mono": _displacement_deviation(r, mono),
+            "newton_iterations": int(sum(h["newton_iterations"])),
+        }
+    out["adaptive"].update(_adapt_figures(results["adaptive"].adaptations, best["adaptive"]))
+    _with_memory(out, runs, memory)
+    a, m = out["adaptive"], out["mono"]
+    out["criterion_4"] = {
+        "max_displacement_deviation_from_mono": a["max_displacement_deviation_from_mono"],
+        "patch_over_plastic_cover": a["patch_fraction"] / a["plastic_cover_fraction"],
+        "fixed_patch_over_plastic_cover": out["fixed"]["patch_fraction"]
+        / out["fixed"]["plastic_cover_fraction"],
+        "T_mono_over_T_adaptive": m["wall_time_s"] / a["wall_time_s"],
+        "T_mono_over_T_fixed": m["wall_time_s"] / out["fixed"]["wall_time_s"],
+        "max_coarse_yield_ratio": a["max_coarse_yield_ratio"],
+        "targets": {
+            "max_displacement_deviation_from_mono": "<= 0.005",
+            "patch_over_plastic_cover": "<= 1.5",
+            "T_mono_over_T_adaptive": ">= 8",
+        },
+    }
+    return out
+
+
+#: The cases, by ``--case`` name (the ball impact joins with the explicit adaptation).
+CASES: dict[str, Callable[[int, bool], dict]] = {"sphere": sphere_case, "plate": plate_case}
+
+
+def main(argv=None) -> dict:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--case", choices=(*CASES, "all"), default="all")
+    parser.add_argument("--repeat", type=int, default=1)
+    parser.add_argument("--no-memory", action="store_true", help="skip the tracemalloc runs")
+    args = parser.parse_args(argv)
+    names = list(CASES) if args.case == "all" else [args.case]
+    out: dict = {"repeat": args.repeat, "threads": _threads.settings(), "cases": {}}
+    with warnings.catch_warnings():  # the JSON gives the coarse-yield figures
+        warnings.simplefilter("ignore")
+        for name in names:
+            out["cases"][name] = CASES[name](args.repeat, not args.no_memory)
+    print(json.dumps(out, indent=2, default=float))
+    return out
+
+
+if __name__ == "__main__":
+    main()
