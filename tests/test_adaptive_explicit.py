@@ -218,3 +218,75 @@ def test_explicit_adaptation_refuses_extra_constraints_and_checkpoints():
                        restore=(None, None))  # fmt: skip
     with pytest.raises(ValueError, match="interval"):
         AdaptivePatch(interval=-1.0)
+
+
+def test_explicit_adaptation_of_one_body_of_a_multi_body_problem():
+    """Two struck bars side by side in one system, the second's patch adapting
+    (BodyAdaptation): the first body's fields go through the growths untouched (its blocks
+    are the same dofs, before the grown body's), the second's jump as in the one-body run."""
+    from arlequin.adapt import BodyAdaptation
+    from arlequin.problem.bodies import MultiBodyProblem
+
+    first, _, mode = _struck()
+    second, mesh, _ = _struck()
+    bodies = MultiBodyProblem({"a": first, "b": second})
+    v0 = np.concatenate([_nodal(first, mode), _nodal(second, mode)])
+    adapt = BodyAdaptation(AdaptivePatch(indicator=_grow_at(mesh, {100: 0.8}), buffer=0,
+                                         every=50), "b")  # fmt: skip
+    dt = 1.5e-5  # s, below both systems' critical steps (2.1e-5 s): the same steps
+    res = arlequin.solve(bodies, "explicit", dt=dt, n_steps=150, v0=v0, adapt=adapt)
+    alone = arlequin.solve(first, "explicit", dt=dt, n_steps=150, v0=_nodal(first, mode))
+    assert [a.step for a in res.adaptations] == [100]
+    assert abs(res.adaptations[0].energy_jump) <= 1e-3  # one body of two: half the 1.5e-4
+    assert res.problem is adapt.problem and res.problem.bodies["b"] is adapt.body_problem
+    n = alone.u.size  # body "a" first: the same steps as alone, to round-off
+    for got, ref in ((res.u[:n], alone.u), (res.v[:n], alone.v)):
+        assert np.abs(got - ref).max() <= 1e-10 * np.abs(ref).max()
+
+
+# -- the ball impact, adaptive (arlequin ball-impact --regime plastic --adaptive) --------------
+BALL = {"regime": "plastic", "block_radius": 0.02, "block_height": 0.02,
+        "coarse_size": 0.25 * np.pi * 0.01 / 20}  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    ("options", "match"),
+    [
+        ({"adaptive": True}, "regime"),  # the elastic regime's block patch has no J2 states
+        ({"adaptive": True, "regime": "plastic", "model": "mono"}, "model"),
+        ({"adaptive": True, "regime": "plastic", "block_patch_size": 0.008}, "block_patch_size"),
+        ({"adapt_threshold": 0.0}, "adapt_threshold"),
+        ({"adapt_threshold": 1.5}, "adapt_threshold"),
+        ({"adapt_buffer": -1}, "adapt_buffer"),
+        ({"adapt_every": 0}, "adapt_every"),
+        ({"max_patch_fraction": 0.0}, "max_patch_fraction"),
+    ],
+)
+def test_ball_impact_adaptive_bad_input_named(options, match):
+    from arlequin.demos.ball_impact import BallImpactConfig
+
+    with pytest.raises(ValueError, match=match):
+        BallImpactConfig(**options).check()
+
+
+@pytest.mark.slow
+def test_ball_impact_adaptive_cap_stops_the_run_with_the_steps_on_disk(tmp_path):
+    """The plastic set-up of test_ball_impact's plastic runs, adaptive, capped at 4% of the
+    block: the patch grows from its seed (0.027 of the block) and the growth past 0.04 (at
+    step 650, measured) stops the run with PatchLimitError; the folder is marked failed and
+    keeps the history rows up to the check that stopped it."""
+    import json
+
+    from arlequin.demos.ball_impact import run_ball_impact
+    from arlequin.io import read_history
+
+    with pytest.raises(PatchLimitError, match="max_fraction") as info:
+        run_ball_impact(adaptive=True, max_patch_fraction=0.04, out=tmp_path, **BALL)
+    err = info.value
+    assert err.result is not None and err.result.n_steps == err.step
+    assert err.result.adaptations and err.result.adaptations[-1].patch_fraction <= 0.04
+    meta = json.loads((tmp_path / "results.json").read_text())
+    assert meta["status"] == "failed" and "max_fraction" in meta["message"]
+    # impact.csv: a row every t_end/1000 (1e-7 s here) up to the check that stopped the run
+    t = read_history(tmp_path / "impact.csv")["t"]
+    assert err.time * 0.98 <= t[-1] <= err.time

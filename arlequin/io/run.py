@@ -66,6 +66,8 @@ class DynamicRunWriter:
         }
         folder.meta.setdefault("field_units", {}).update(self.layout.units)
         self.frame_times = None if frame_times is None else np.sort(np.asarray(frame_times))
+        self._folder, self._prefix = folder, prefix
+        self._meshes = {bf.name: bf.mesh for bf in self.layout.blocks}
         self._next = 0
         self._e0: float | None = None
         self.frames_written: list[float] = []
@@ -85,6 +87,21 @@ class DynamicRunWriter:
         self.history.append(row)
         if self._due(integ.t, integ.step_size):
             self.write_frame(integ.t, integ.u, integ.v, integ.multipliers)
+
+    def on_adapt(self, integ: Any, adapt: Any) -> None:
+        """A patch grew (``solve(..., adapt=)``): the next rows and frames on the new system,
+        the blocks whose mesh changed into a new series ``fields/NAME_K.xdmf`` (K the growths
+        so far), the balance moved by the growth's energy change."""
+        self.system, self.layout = integ.system, adapt.problem.field_layout()
+        self._growths = getattr(self, "_growths", 0) + 1
+        for bf in self.layout.blocks:
+            if bf.mesh is not self._meshes.get(bf.name):
+                name = f"{self._prefix}{bf.name}_{self._growths}"
+                self.series[bf.name] = self._folder.series(name, bf.mesh)
+                self._meshes[bf.name] = bf.mesh
+        change = getattr(adapt.records[-1], "energy_change", None) if adapt.records else None
+        if self._e0 is not None and change is not None:
+            self._e0 += change
 
     def _due(self, t: float, dt: float | None) -> bool:
         if self.frame_times is None:

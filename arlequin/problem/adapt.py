@@ -98,6 +98,8 @@ class Adaptation:
         by the solver after the multipliers are re-solved).
     newton_iterations : int
         Iterations of that re-solve.
+    energy_change : float or None
+        E_after − E_before (J) (explicit runs: the listeners' energy balances move by it).
     wall_time_s : float
         Time spent rebuilding and transferring (s), the re-solve excluded.
     """
@@ -111,6 +113,7 @@ class Adaptation:
     energy_jump: float | None = None
     newton_iterations: int = 0
     wall_time_s: float = 0.0
+    energy_change: float | None = None
 
     def to_json(self) -> dict[str, Any]:
         """The adaptation as plain JSON (an entry of the demos' ``adaptations``)."""

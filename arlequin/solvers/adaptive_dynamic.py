@@ -27,6 +27,7 @@ the integrator's time is the committed one, earlier than the last step they saw)
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import math
 from collections.abc import Callable, Sequence
@@ -40,6 +41,7 @@ __all__ = [
     "DynamicAdapter",
     "bind_adaptation",
     "finish_adaptive",
+    "moved_constraint_state",
     "rebuild",
     "run_adaptive_loop",
     "total_energy",
@@ -154,16 +156,24 @@ class DynamicAdapter:
         step, t = integ.step_count, integ.t
         problem, u, states = self.adapt.grow(growth, integ.u, integ.states, step, t)
         v = self.adapt.transfer_displacement(integ.v)
-        new = self.build(problem, t, u, v)
+        changed = {}
+        if integ.unilateral:  # contact pairs between bodies: rebuilt on the new dof map
+            changed["constraints"] = self.adapt.constraints_for(problem)
+        new = self.build(problem, t, u, v, **changed)
         # the moved states (the old fine cells' own, the new ones virgin) replace the initial
         # ones the constructor started from: forces, impulse and multipliers again from them
         new.states = {**new.states, **states}
+        for c in new.unilateral:
+            if c.name in integ.constraint_states:
+                new.constraint_states[c.name] = moved_constraint_state(
+                    integ.constraint_states[c.name], new.constraint_states[c.name], integ.ops.n
+                )
         new._initialize()
         _carry(integ, new)
         after = total_energy(new)
         record = self.adapt.records[-1]
         record.energy_jump = (after - before) / abs(before) if before else 0.0
-        record.wall_time_s = float(record.wall_time_s)
+        record.energy_change = after - before
         logger.info(
             "t = %.6e s: patch grown, total energy %.9g -> %.9g J (jump %.3g), stable step "
             "%.4g s", t, before, after, record.energy_jump, float(new.critical_dt or math.nan),
@@ -172,6 +182,27 @@ class DynamicAdapter:
         for hook in self.listeners:
             hook(new, self.adapt)
         return new
+
+
+def moved_constraint_state(old: Any, new: Any, n_old: int) -> Any:
+    """A unilateral constraint's committed state moved onto the grown system: its per-point
+    history (statuses, multipliers, impulses, works, records: the contact points are the other
+    body's, unchanged) from ``old``, what lives on the dofs (arrays of the old system's
+    ``n_old`` dofs, a geometry with rows) from ``new``, its initial state there; nested
+    dataclasses (a friction state's normal part) field by field."""
+    if not dataclasses.is_dataclass(old) or type(old) is not type(new):
+        return new
+    values = {}
+    for f in dataclasses.fields(old):
+        a, b = getattr(old, f.name), getattr(new, f.name)
+        on_dofs = isinstance(a, np.ndarray) and a.ndim >= 1 and a.shape[-1] == n_old
+        if on_dofs or hasattr(a, "rows"):
+            values[f.name] = b
+        elif dataclasses.is_dataclass(a) and type(a) is type(b) and hasattr(b, "geometry"):
+            values[f.name] = moved_constraint_state(a, b, n_old)
+        else:
+            values[f.name] = a
+    return dataclasses.replace(old, **values)
 
 
 def _carry(old: Any, new: Any) -> None:
@@ -219,9 +250,10 @@ def bind_adaptation(adapt: Any, system: Any, restore: Any, options: dict[str, An
     if restore is not None:
         raise ValueError("restore (a checkpoint) cannot be combined with adapt: the snapshot "
                          "is of the patch it was taken with")  # fmt: skip
-    if options.get("constraints"):
+    if options.get("constraints") and not callable(getattr(adapt, "constraints_for", None)):
         raise ValueError("extra constraints cannot be combined with adapt: their rows are on "
-                         "the dofs of the patch before it grows")  # fmt: skip
+                         "the dofs of the patch before it grows (a BodyAdaptation's "
+                         "constraints= rebuilds them)")  # fmt: skip
     return adapt.bind(system)
 
 

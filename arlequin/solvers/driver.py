@@ -220,8 +220,9 @@ def _solve(cls, system, t_end, dt, n_steps, t0, u0, v0, t_eval, step_controller,
                  on_checkpoint)  # fmt: skip
     if adapt is not None:
 
-        def build(problem, t_start, u_start, v_start):
-            new = rebuild(cls, problem, dt, t_start, u_start, v_start, step_controller, options)
+        def build(problem, t_start, u_start, v_start, **changed):
+            new = rebuild(cls, problem, dt, t_start, u_start, v_start, step_controller,
+                          {**options, **changed})  # fmt: skip
             if t_end is not None and isinstance(new.controller, FixedStep):
                 _land_on_end(new, t_start, t_end)
             if stops:
