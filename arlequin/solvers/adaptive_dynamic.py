@@ -69,8 +69,9 @@ class DynamicAdapter:
     adapt : AdaptivePatch
         Already bound to the run's problem.
     build : callable
-        ``build(problem, t0, u0, v0) -> Integrator``: an integrator of the run's scheme and
-        options on a new problem at time ``t0`` (s), its stop times set.
+        ``build(problem, t0, u0, v0, **changed) -> Integrator``: an integrator of the run's
+        scheme and options (``changed`` replacing some: the rebuilt ``constraints``) on a new
+        problem at time ``t0`` (s), its stop times set.
     listeners : sequence
         The run's listeners; those with an ``on_adapt(integrator, adapt)`` member are told of
         each growth.
@@ -98,14 +99,16 @@ class DynamicAdapter:
         return self._late and getattr(integ, "_j", 0) == 0
 
     # -- the check ------------------------------------------------------------------------
-    def start(self, loop: Any) -> None:
-        """The check of the initial state (a growth before the first step; a user indicator of
-        the wrong shape refused before any step)."""
-        self.check(loop, loop.integ.step_count)
-
     def check(self, loop: Any, k: int) -> tuple[Any, bool]:
-        """The check after step ``k``: ``(integrator to go on with, whether the loop went back
-        to the committed state)``. ``loop`` has ``integ``, ``rec`` and ``pending``."""
+        """The check after step ``k`` (0: the initial state, so that a user indicator of the
+        wrong shape is refused before any step): ``(integrator to go on with, whether the loop
+        went back to the committed state)``. ``loop`` has ``integ``, ``rec`` and ``pending``.
+
+        Raises
+        ------
+        PatchLimitError, IndicatorError, SimulationError
+            ``err.result`` holds what was recorded until then, with the adaptations.
+        """
         self._late = False
         integ = loop.integ
         try:
