@@ -269,7 +269,7 @@ class BallImpactConfig(DemoConfig):
                   "rigid_wall": bool(self.rigid_wall), "coarse_step_ratio": int(ratio),
                   "t_end": t_end, "ball_material": _material_record(ball),
                   "block_material": _material_record(block),
-                  "adaptive": bool(self.adaptive), **(adapt or {})}  # fmt: skip
+                  "adaptive": bool(self.adaptive), **self._adapt_values()}  # fmt: skip
         return ResolvedInputs(self.regime, self.model, velocity, big, block_radius,
                               block_height, ball, block, fine, sizes, self.friction,
                               bool(self.rigid_wall), int(ratio), t_end, record,
@@ -293,6 +293,10 @@ class BallImpactConfig(DemoConfig):
         if self.block_patch_size is not None:
             raise ValueError(f"adaptive starts from a seed of radius patch_size at the contact: "
                              f"give no block_patch_size, got {self.block_patch_size}")  # fmt: skip
+        return self._adapt_values()
+
+    def _adapt_values(self) -> dict[str, Any]:
+        """The adaptive options as recorded (with or without ``adaptive``)."""
         return {"adapt_threshold": float(self.adapt_threshold),
                 "adapt_buffer": int(self.adapt_buffer), "adapt_every": int(self.adapt_every),
                 "max_patch_fraction": float(self.max_patch_fraction)}  # fmt: skip
