@@ -295,7 +295,10 @@ class AdaptivePatch:
         """Check ``problem`` (an ArlequinProblem, its patch nested, its coarse model linear,
         the patch's model with :class:`~arlequin.contract.SupportsCellStates`) and keep it."""
         if not isinstance(problem, ArlequinProblem):
-            raise ValueError(f"adaptation needs an ArlequinProblem, got {type(problem).__name__}")
+            hint = (": adapt one body with arlequin.adapt.BodyAdaptation(adapt, body)"
+                    if hasattr(problem, "bodies") else "")  # fmt: skip
+            raise ValueError(f"adaptation needs an ArlequinProblem, got "
+                             f"{type(problem).__name__}{hint}")  # fmt: skip
         if not 0 <= self.index < len(problem.patches):
             raise ValueError(f"patch={self.index}: the problem has {len(problem.patches)} patches")
         coarse = problem.coarse

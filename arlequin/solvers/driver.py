@@ -151,12 +151,13 @@ def solve(
         ``(snapshot, recorder_state)`` of a checkpoint: the run continues from the snapshot's
         time with what was recorded until then (the same system, integrator, options, stops and
         listeners as the interrupted run give the same steps and values bit for bit).
-    adapt : AdaptivePatch, optional
-        A nested patch of ``system`` (an :class:`~arlequin.ArlequinProblem`) that grows where
-        the material yields (:mod:`arlequin.problem.adapt`), checked every ``adapt.every``
-        steps or ``adapt.interval`` s (:mod:`arlequin.solvers.adaptive_dynamic`); the result
-        gains ``adaptations``, ``max_coarse_yield_ratio`` and the final ``problem``. Not with
-        ``restore`` nor extra ``constraints`` (their dofs would not follow the patch).
+    adapt : AdaptivePatch or BodyAdaptation, optional
+        A nested patch of ``system`` (an :class:`~arlequin.ArlequinProblem`; a body's of a
+        multi-body problem with a ``BodyAdaptation``) that grows where the material yields
+        (:mod:`arlequin.problem.adapt`), checked every ``adapt.every`` steps or
+        ``adapt.interval`` s (:mod:`arlequin.solvers.adaptive_dynamic`); the result gains
+        ``adaptations``, ``max_coarse_yield_ratio`` and the final ``problem``. Not with
+        ``restore``; extra ``constraints`` only with a ``BodyAdaptation`` that rebuilds them.
     **options
         Passed to the integrator class (``beta``, ``gamma``, ``alpha``, ``theta``, ``safety``,
         ``constraints``, ``consistent_initial``...).
