@@ -66,6 +66,9 @@ class DynamicRunWriter:
         }
         folder.meta.setdefault("field_units", {}).update(self.layout.units)
         self.frame_times = None if frame_times is None else np.sort(np.asarray(frame_times))
+        self._folder, self._prefix = folder, prefix
+        self._meshes = {bf.name: bf.mesh for bf in self.layout.blocks}
+        self._pending_series: dict[str, tuple[str, Any]] = {}
         self._next = 0
         self._e0: float | None = None
         self.frames_written: list[float] = []
@@ -86,6 +89,22 @@ class DynamicRunWriter:
         if self._due(integ.t, integ.step_size):
             self.write_frame(integ.t, integ.u, integ.v, integ.multipliers)
 
+    def on_adapt(self, integ: Any, adapt: Any) -> None:
+        """A patch grew (``solve(..., adapt=)``): the next rows and frames on the new system,
+        the blocks whose mesh changed into a new series ``fields/NAME_K.xdmf`` (K the growths
+        so far), the balance moved by the growth's energy change."""
+        self.system, self.layout = integ.system, adapt.problem.field_layout()
+        self._growths = getattr(self, "_growths", 0) + 1
+        for bf in self.layout.blocks:
+            if bf.mesh is not self._meshes.get(bf.name):
+                # opened at the next frame: growths between two frames leave no empty series
+                self._pending_series[bf.name] = (f"{self._prefix}{bf.name}_{self._growths}",
+                                                 bf.mesh)  # fmt: skip
+                self._meshes[bf.name] = bf.mesh
+        change = getattr(adapt.records[-1], "energy_change", None) if adapt.records else None
+        if self._e0 is not None and change is not None:
+            self._e0 += change
+
     def _due(self, t: float, dt: float | None) -> bool:
         if self.frame_times is None:
             return True
@@ -98,6 +117,9 @@ class DynamicRunWriter:
 
     def write_frame(self, t, u, v=None, multipliers=None) -> None:
         """One frame of every block at time t (s)."""
+        for name, (file, mesh) in self._pending_series.items():
+            self.series[name] = self._folder.series(file, mesh)
+        self._pending_series = {}
         for name, (point, cell) in self.layout.frame(self.system.dofmap, u, v, multipliers).items():
             self.series[name].write(t, point, cell)
         self.frames_written.append(float(t))

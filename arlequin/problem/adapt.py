@@ -99,6 +99,8 @@ class Adaptation:
         by the solver after the multipliers are re-solved).
     newton_iterations : int
         Iterations of that re-solve.
+    energy_change : float or None
+        E_after − E_before (J) (explicit runs: the listeners' energy balances move by it).
     wall_time_s : float
         Time spent rebuilding the patch (its mesh, model, overlap, weights, gluing band,
         coupling rows) and transferring the fields (s).
@@ -122,6 +124,7 @@ class Adaptation:
     system_time_s: float = 0.0
     resolve_time_s: float = 0.0
     discarded_time_s: float = 0.0
+    energy_change: float | None = None
 
     @property
     def adapt_time_s(self) -> float:
@@ -234,7 +237,10 @@ class AdaptivePatch:
     band_cells : int
         The plastic zone within this many fine cells of the gluing band grows the patch.
     every : int
-        The indicator is evaluated every ``every`` steps (the yield check every step).
+        The indicator is evaluated every ``every`` steps (quasi-static: the yield check every
+        step; explicit runs: both every ``every`` time steps).
+    interval : float, optional
+        Explicit runs: evaluate every ``interval`` seconds of simulated time instead (s).
     max_fraction : float
         Largest share of the coarse mesh's area the patch may reach, in (0, 1].
     indicator : callable, optional
@@ -266,6 +272,7 @@ class AdaptivePatch:
         patch: int = 0,
         reject_band_plasticity: bool = True,
         closure: Callable[[np.ndarray], np.ndarray] | None = None,
+        interval: float | None = None,
     ) -> None:
         if not (isinstance(threshold, (int, float)) and 0.0 < threshold <= 1.0):
             raise ValueError(f"threshold β must lie in (0, 1], got threshold={threshold!r}")
@@ -273,6 +280,11 @@ class AdaptivePatch:
                                  ("every", every, 1), ("patch", patch, 0)):  # fmt: skip
             if isinstance(value, bool) or int(value) != value or value < low:
                 raise ValueError(f"{name} must be an integer >= {low}, got {name}={value!r}")
+        if interval is not None and not (
+            isinstance(interval, (int, float)) and math.isfinite(interval) and interval > 0.0
+        ):
+            raise ValueError(f"interval must be a positive time (s), got interval={interval!r}")
+        self.interval = None if interval is None else float(interval)
         if not (0.0 < max_fraction <= 1.0):
             raise ValueError(f"max_fraction must lie in (0, 1], got max_fraction={max_fraction}")
         if levels is not None and (int(levels) != levels or levels < 0):
@@ -304,7 +316,10 @@ class AdaptivePatch:
         """Check ``problem`` (an ArlequinProblem, its patch nested, its coarse model linear,
         the patch's model with :class:`~arlequin.contract.SupportsCellStates`) and keep it."""
         if not isinstance(problem, ArlequinProblem):
-            raise ValueError(f"adaptation needs an ArlequinProblem, got {type(problem).__name__}")
+            hint = (": adapt one body with arlequin.adapt.BodyAdaptation(adapt, body)"
+                    if hasattr(problem, "bodies") else "")  # fmt: skip
+            raise ValueError(f"adaptation needs an ArlequinProblem, got "
+                             f"{type(problem).__name__}{hint}")  # fmt: skip
         if not 0 <= self.index < len(problem.patches):
             raise ValueError(f"patch={self.index}: the problem has {len(problem.patches)} patches")
         coarse = problem.coarse
@@ -362,8 +377,9 @@ class AdaptivePatch:
         return AdaptView(step, float(solver.t), self.problem, parts["coarse"], parts[self.name],
                          solver.states[self.name][0], self.cells, vm, sy)  # fmt: skip
 
-    def assess(self, solver: Any, step: int) -> Growth | None:
-        """After a converged step: None (keep the patch) or the :class:`Growth` to make."""
+    def assess(self, solver: Any, step: int, due: bool | None = None) -> Growth | None:
+        """After a converged step: None (keep the patch) or the :class:`Growth` to make
+        (``due``: whether the indicator is evaluated now; default every ``every`` steps)."""
         view = self.view(solver, step)
         n = self.problem.coarse.mesh.nelements
         outside = np.ones(n, dtype=bool)
@@ -374,7 +390,7 @@ class AdaptivePatch:
         reject = worst > 1.0 or (in_band and self.reject_band_plasticity and band_flags.any())
         if not reject:
             self.max_coarse_yield_ratio = max(self.max_coarse_yield_ratio, worst)
-            if step % self.every:
+            if (step % self.every) if due is None else not due:
                 return None
         flags = self._flags(view, ratio, outside, band_flags)
         if reject:

@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from ..contract import SimulationError
+from .adaptive_dynamic import DynamicAdapter, bind_adaptation, rebuild, run_adaptive_loop
 from .base import Integrator
 from .controllers import FixedStep
 from .recorder import Recorder
@@ -102,6 +103,7 @@ def solve(
     on_step: Sequence[Callable[[Integrator], None]] = (),
     on_checkpoint: Callable[[Integrator, Recorder], None] | None = None,
     restore: Any = None,
+    adapt: Any = None,
     **options: Any,
 ) -> DynamicResult:
     """Integrate a coupled system in time.
@@ -149,6 +151,13 @@ def solve(
         ``(snapshot, recorder_state)`` of a checkpoint: the run continues from the snapshot's
         time with what was recorded until then (the same system, integrator, options, stops and
         listeners as the interrupted run give the same steps and values bit for bit).
+    adapt : AdaptivePatch or BodyAdaptation, optional
+        A nested patch of ``system`` (an :class:`~arlequin.ArlequinProblem`; a body's of a
+        multi-body problem with a ``BodyAdaptation``) that grows where the material yields
+        (:mod:`arlequin.problem.adapt`), checked every ``adapt.every`` steps or
+        ``adapt.interval`` s (:mod:`arlequin.solvers.adaptive_dynamic`); the result gains
+        ``adaptations``, ``max_coarse_yield_ratio`` and the final ``problem``. Not with
+        ``restore``; extra ``constraints`` only with a ``BodyAdaptation`` that rebuilds them.
     **options
         Passed to the integrator class (``beta``, ``gamma``, ``alpha``, ``theta``, ``safety``,
         ``constraints``, ``consistent_initial``...).
@@ -166,14 +175,16 @@ def solve(
     with blas_threads(cls.blas_threads):
         return _solve(cls, system, t_end, dt, n_steps, t0, u0, v0, t_eval, step_controller,
                       callback, record_every, save_fields, on_record, on_step, on_checkpoint,
-                      restore, options)  # fmt: skip
+                      restore, options, adapt)  # fmt: skip
 
 
 def _solve(cls, system, t_end, dt, n_steps, t0, u0, v0, t_eval, step_controller, callback,
            record_every, save_fields, on_record, on_step, on_checkpoint, restore,
-           options) -> DynamicResult:  # fmt: skip
+           options, adapt=None) -> DynamicResult:  # fmt: skip
     """:func:`solve` with the integrator's class resolved."""
     _check_options(cls, options)
+    if adapt is not None:
+        system = bind_adaptation(adapt, system, restore, options)
     if t_end is None and n_steps is None and t_eval is not None:
         t_end = float(np.max(np.asarray(t_eval, dtype=float)))
     t0, t_end, n_steps = _check_span(t0, t_end, n_steps, record_every)
@@ -208,6 +219,19 @@ def _solve(cls, system, t_end, dt, n_steps, t0, u0, v0, t_eval, step_controller,
         pending = list(times[times > t_start + 1e-12 * float(integ.dt)])
     loop = _Loop(integ, rec, n_steps, t_end, record_every, pending, callback, on_step,
                  on_checkpoint)  # fmt: skip
+    if adapt is not None:
+
+        def build(problem, t_start, u_start, v_start, **changed):
+            new = rebuild(cls, problem, dt, t_start, u_start, v_start, step_controller,
+                          {**options, **changed})  # fmt: skip
+            if t_end is not None and isinstance(new.controller, FixedStep):
+                _land_on_end(new, t_start, t_end)
+            if stops:
+                new.set_stops(stops)
+            return new
+
+        loop.adapter = DynamicAdapter(adapt, build, (*on_step, *on_record))
+        return run_adaptive_loop(loop, adapt)
     return loop.run()
 
 
@@ -259,6 +283,7 @@ class _Loop:
         self.n_steps, self.t_end, self.record_every = n_steps, t_end, record_every
         self.pending, self.callback = pending, callback
         self.on_step, self.on_checkpoint = on_step, on_checkpoint
+        self.adapter = None  # an adaptive patch's checks (adaptive_dynamic.DynamicAdapter)
 
     def _done(self, k: int) -> bool:
         if self.n_steps is not None and k >= self.n_steps:
@@ -290,6 +315,8 @@ class _Loop:
         k = integ.step_count
         verbose = logger.isEnabledFor(logging.INFO)
         next_log = time.perf_counter() + LOG_INTERVAL
+        if self.adapter is not None:
+            integ, _ = self.adapter.check(self, k)
         while not self._done(k):
             self._step()
             k += 1
@@ -298,11 +325,16 @@ class _Loop:
             if verbose and time.perf_counter() >= next_log:
                 _log_progress(integ)
                 next_log = time.perf_counter() + LOG_INTERVAL
-            if not self._take(k):
-                continue
-            rec.record()
-            if self.on_checkpoint is not None:
-                self.on_checkpoint(integ, rec)
-            if self.callback is not None and self.callback(integ):
-                return rec.result(1, f"stopped by the callback at step {k}, t = {integ.t:.6e} s")
+            if self._take(k):
+                rec.record()
+                if self.on_checkpoint is not None:
+                    self.on_checkpoint(integ, rec)
+                if self.callback is not None and self.callback(integ):
+                    msg = f"stopped by the callback at step {k}, t = {integ.t:.6e} s"
+                    return rec.result(1, msg)
+            if self.adapter is not None and self.adapter.due(integ, k, self._done(k)):
+                # after the record: a growth goes on from the recorded state, a rejected
+                # interval forgets its records (adaptive_dynamic)
+                integ, _ = self.adapter.check(self, k)
+                k = integ.step_count
         return rec.result(0, f"reached t = {integ.t:.6e} s in {integ.step_count} steps")

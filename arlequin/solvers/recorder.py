@@ -20,6 +20,16 @@ from .result import DynamicResult
 __all__ = ["Recorder"]
 
 
+def _stacked(values: list[np.ndarray]) -> np.ndarray:
+    """The recorded arrays as one array (n_rec, ...); arrays of several sizes (an adaptive
+    patch's multipliers and fields change size as it grows) as an object array of them."""
+    if len({np.shape(v) for v in values}) <= 1:
+        return np.array(values)
+    out = np.empty(len(values), dtype=object)
+    out[:] = values
+    return out
+
+
 class Recorder:
     """Samples an integrator.
 
@@ -98,7 +108,7 @@ class Recorder:
 
         fields = None
         if self.save_fields:
-            fields = {"u": np.array(self.us), "v": np.array(self.vs)}
+            fields = {"u": _stacked(self.us), "v": _stacked(self.vs)}
         sizes = np.array(self.sizes)
         last = it.step_size if it.step_size is not None else it.dt
         return DynamicResult(
@@ -112,7 +122,7 @@ class Recorder:
             coupling_work=hist("coupling_work"),
             constraint_work=hist("constraint_work"),
             damping_work=hist("damping_work"),
-            multipliers={k: np.array(v) for k, v in self.mult.items()},
+            multipliers={k: _stacked(v) for k, v in self.mult.items()},
             status_iterations=np.array(self.iters, dtype=np.int64),
             u=it.u.copy(),
             v=it.v.copy(),

@@ -31,7 +31,7 @@ import numpy as np
 import scipy.sparse as sp
 from skfem import Basis, Mesh
 
-from arlequin.contract import StateError
+from arlequin.contract import CellStates, StateError
 
 from ..elastic import LinearElastic, WeightLike, element_critical_step
 from .j2 import (
@@ -73,7 +73,7 @@ class BulkViscosity:
                 raise ValueError(f"bulk viscosity coefficient {name} must be >= 0, got {v}")
 
 
-class FiniteStrainJ2:
+class FiniteStrainJ2(CellStates):
     """Finite-strain J2 elastoplastic model with F-bar on one Q1 mesh (explicit dynamics).
 
     Parameters
@@ -218,6 +218,16 @@ class FiniteStrainJ2:
         zeros = np.zeros((ne, nq))
         return PlasticState(eye, zeros, np.zeros((3, 3, ne, nq)), np.ones((ne, nq)), zeros,
                             zeros.copy())  # fmt: skip
+
+    def yield_stress(self, state: PlasticState | None = None) -> np.ndarray:
+        """σ_y(ε̄p) (Pa), shape (n_elems, n_qp); σ_y0 for None (adaptive patches' member, with
+        ``state_of_cells`` and ``with_cells`` of :class:`~arlequin.contract.CellStates`)."""
+        eqps = np.zeros(self.shape) if state is None else np.asarray(state.eqps)
+        return np.asarray(self.material.law.flow_stress(eqps), dtype=float) + 0.0 * eqps
+
+    def equivalent_plastic_strain(self, state: PlasticState) -> np.ndarray:
+        """ε̄p at the quadrature points, shape (n_elems, n_qp)."""
+        return np.asarray(state.eqps)
 
     # ------------------------------------------------------------------ kinematics
     def deformation_gradient(self, u: np.ndarray) -> np.ndarray:

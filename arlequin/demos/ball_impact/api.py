@@ -32,6 +32,11 @@ def run_ball_impact(
     rigid_wall: bool = False,
     coarse_step_ratio: int | None = None,
     t_end: float | None = None,
+    adaptive: bool = False,
+    adapt_threshold: float = 0.8,
+    adapt_buffer: int = 1,
+    adapt_every: int = 50,
+    max_patch_fraction: float = 0.5,
     out: str | Path | None = None,
     progress: Callable[[float], None] | None = None,
     check_only: bool = False,
@@ -78,6 +83,11 @@ def run_ball_impact(
         Simulated time (s); default 1.4 × Hertz's duration (elastic) or 1.5 π √(m/k) with
         k = 6π R σ_y, the stiffness of a fully plastic contact at a mean pressure 3 σ_y
         (plastic).
+    adaptive, adapt_threshold, adapt_buffer, adapt_every, max_patch_fraction
+        The block's J2 patch adapts (plastic regime, :mod:`arlequin.adapt`): a seed of radius
+        ``patch_size`` grows where the coarse block's von Mises stress reaches β σy or the
+        plastic zone nears the band (plus rings ≥ 0 of coarse cells), checked every N ≥ 1
+        steps; beyond F in (0, 1] of the block the run stops (``PatchLimitError``).
     out : path, optional
         Results folder.
     progress : callable, optional
@@ -96,7 +106,9 @@ def run_ball_impact(
         block_material=block_material, patch_size=patch_size,
         block_patch_size=block_patch_size, fine_size=fine_size, coarse_size=coarse_size,
         friction=friction, rigid_wall=rigid_wall, coarse_step_ratio=coarse_step_ratio,
-        t_end=t_end,
+        t_end=t_end, adaptive=adaptive, adapt_threshold=adapt_threshold,
+        adapt_buffer=adapt_buffer, adapt_every=adapt_every,
+        max_patch_fraction=max_patch_fraction,
     )  # fmt: skip
     if check_only:
         return None

@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 from ...models import IsotropicElastic, J2Material
-from ..config import DemoConfig, _plain, check_choice, option
+from ..config import DemoConfig, _plain, check_choice, check_range, option
 from .result import INPUT_UNITS, BallImpactResult, hertz
 from .setup import BallSizes, ResolvedInputs, ball_sizes, mono_cells
 
@@ -212,6 +212,20 @@ class BallImpactConfig(DemoConfig):
         metavar="T",
         default_help="1.4 x Hertz's contact duration (elastic), 1.5 pi sqrt(m/k) (plastic)",
     )
+    adaptive: bool = option(
+        False, "adaptive block patch (--regime plastic): a seed of radius --patch-size at the "
+        "contact that grows where the block nears yield", "",
+    )  # fmt: skip
+    adapt_threshold: float = option(0.8, "coarse cells whose von Mises stress reaches BETA σy "
+                                    "join the patch", "1", metavar="BETA")  # fmt: skip
+    adapt_buffer: int = option(1, "rings of coarse cells added around the flagged ones", "1",
+                               metavar="RINGS")  # fmt: skip
+    adapt_every: int = option(50, "evaluate the indicator (and the yield check) every N time "
+                              "steps", "1", metavar="N")  # fmt: skip
+    max_patch_fraction: float = option(
+        0.5, "largest share of the block the adaptive patch may cover (beyond: the run stops)",
+        "1", metavar="F",
+    )  # fmt: skip
     ball_material: IsotropicElastic | None = option(  # noqa: RUF009 (frozen materials)
         None, "the ball's material (default steel)", "", cli=False
     )
@@ -239,6 +253,7 @@ class BallImpactConfig(DemoConfig):
         self._check_options(block)
         coarse, fine = self._cell_sizes(big, velocity, ball, block)
         sizes = self._patch_sizes(big, coarse, fine, block_radius, block_height)
+        adapt = self._check_adaptive()
         ratio = self.coarse_step_ratio
         if ratio is None:
             # 2: larger ratios resonate (the rigid-wall default, three levels, at m = 4: the
@@ -253,10 +268,38 @@ class BallImpactConfig(DemoConfig):
                   "coarse_size": self.coarse_size, "friction": self.friction,
                   "rigid_wall": bool(self.rigid_wall), "coarse_step_ratio": int(ratio),
                   "t_end": t_end, "ball_material": _material_record(ball),
-                  "block_material": _material_record(block)}  # fmt: skip
+                  "block_material": _material_record(block),
+                  "adaptive": bool(self.adaptive), **self._adapt_values()}  # fmt: skip
         return ResolvedInputs(self.regime, self.model, velocity, big, block_radius,
                               block_height, ball, block, fine, sizes, self.friction,
-                              bool(self.rigid_wall), int(ratio), t_end, record)  # fmt: skip
+                              bool(self.rigid_wall), int(ratio), t_end, record,
+                              adapt)  # fmt: skip
+
+    def _check_adaptive(self) -> dict[str, Any] | None:
+        """The adaptive options checked; their values (None without ``adaptive``)."""
+        check_range("adapt_threshold", self.adapt_threshold, 0.0, 1.0, closed="(]")
+        for name in ("adapt_buffer", "adapt_every"):
+            value, low = getattr(self, name), 1 if name == "adapt_every" else 0
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or \
+                    int(value) != value or value < low:  # fmt: skip
+                raise ValueError(f"{name} must be an integer >= {low}, got {name}={value!r}")
+        check_range("max_patch_fraction", self.max_patch_fraction, 0.0, 1.0, closed="(]")
+        if not self.adaptive:
+            return None
+        if self.model != "arlequin" or self.regime != "plastic" or self.rigid_wall:
+            raise ValueError(f"adaptive grows the block's J2 patch: it needs model='arlequin' "
+                             f"and regime='plastic' against the block, got model={self.model!r}, "
+                             f"regime={self.regime!r}, rigid_wall={self.rigid_wall}")  # fmt: skip
+        if self.block_patch_size is not None:
+            raise ValueError(f"adaptive starts from a seed of radius patch_size at the contact: "
+                             f"give no block_patch_size, got {self.block_patch_size}")  # fmt: skip
+        return self._adapt_values()
+
+    def _adapt_values(self) -> dict[str, Any]:
+        """The adaptive options as recorded (with or without ``adaptive``)."""
+        return {"adapt_threshold": float(self.adapt_threshold),
+                "adapt_buffer": int(self.adapt_buffer), "adapt_every": int(self.adapt_every),
+                "max_patch_fraction": float(self.max_patch_fraction)}  # fmt: skip
 
     def _materials(self) -> tuple[IsotropicElastic, IsotropicElastic | J2Material]:
         """The ball's and the block's materials: the given (or default) ones with the given

@@ -109,6 +109,14 @@ class ImpactRecorder:
         if self.csv is not None:
             self.csv.append(row)
 
+    def on_adapt(self, integ, adapt) -> None:
+        """The block's patch grew: the measures follow the new set-up, the balance moves by
+        the growth's energy change (recorded with the growth)."""
+        self.bodies.regrow(adapt.problem)
+        change = adapt.records[-1].energy_change
+        if self._e0 is not None and change is not None:
+            self._e0 += change
+
     def result(self, res, wall: float, patch_fraction: float, hertz: dict,
                config: dict) -> BallImpactResult:  # fmt: skip
         """The run's :class:`BallImpactResult` from its records and its final state ``res``."""

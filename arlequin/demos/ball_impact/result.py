@@ -39,7 +39,9 @@ INPUT_UNITS = {"regime": "", "model": "", "velocity": "m/s", "ball_radius": "m",
                "block_radius": "m", "block_height": "m", "patch_size": "m",
                "block_patch_size": "m", "fine_size": "m",
                "coarse_size": "m", "friction": "1", "rigid_wall": "", "coarse_step_ratio": "1",
-               "t_end": "s", "ball_material": "", "block_material": ""}  # fmt: skip
+               "t_end": "s", "ball_material": "", "block_material": "", "adaptive": "",
+               "adapt_threshold": "1", "adapt_buffer": "1", "adapt_every": "1",
+               "max_patch_fraction": "1"}  # fmt: skip
 RESULT_UNITS = {"contact_duration": "s", "peak_force": "N", "restitution": "1",
                 "dent_depth": "m", "max_plastic_strain": "1", "energy_balance_error": "1",
                 "patch_fraction": "1", "n_elements": "1", "wall_time_s": "s",
@@ -47,7 +49,8 @@ RESULT_UNITS = {"contact_duration": "s", "peak_force": "N", "restitution": "1",
                 "hertz_indentation": "m", "hertz_contact_radius": "m", "fine_size": "m",
                 "coarse_size": "m", "n_steps": "1", "contact_radius_cells": "1",
                 "band_max_plastic_strain": "1", "t_end": "s",
-                "mean_step_ratio": "1"}  # fmt: skip
+                "mean_step_ratio": "1", "adaptations": "",
+                "max_coarse_yield_ratio": "1"}  # fmt: skip
 
 
 def hertz(radius: float, mass: float, velocity: float, ball: IsotropicElastic,
@@ -118,6 +121,14 @@ class BallImpactResult(JsonResult):
         The multi-time-step bound M (1: one step for every model).
     mean_step_ratio : float
         The mean ratio m ≤ M the coarse models' macro steps used (1 without multi-time-step).
+    adaptations : list of dict
+        With ``adaptive``: each growth of the block's patch, ``step`` (the time step it grew
+        at), ``time`` (s), ``n_fine_elements``, ``patch_fraction`` (of the block's coarse
+        mesh), ``energy_jump`` (relative change of the total energy across it), ``rejected``
+        (the interval after it was computed again: the coarse block yielded outside the patch).
+    max_coarse_yield_ratio : float or None
+        With ``adaptive``: the largest von Mises / σy of the block's coarse model outside the
+        patch at the accepted checks (1).
     """
 
     contact_duration: float
@@ -140,6 +151,8 @@ class BallImpactResult(JsonResult):
     coarse_step_ratio: int = 1
     mean_step_ratio: float = 1.0
     config: dict[str, Any] = field(default_factory=dict)
+    adaptations: list[dict[str, Any]] = field(default_factory=list)
+    max_coarse_yield_ratio: float | None = None
 
     def to_json(self) -> dict[str, Any]:
         """The Interface's keys first, then Hertz's values, then the inputs and the rest."""

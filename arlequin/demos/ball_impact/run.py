@@ -45,14 +45,20 @@ def run_config(config: BallImpactConfig, out: str | Path | None = None,
     _warn_outside_hertz(inputs)
     bodies = ImpactBodies(inputs.model, inputs.sizes, inputs.radius, inputs.block_radius,
                           inputs.block_height, inputs.ball_material, inputs.block_material,
-                          rigid_wall=inputs.rigid_wall, friction=inputs.friction)  # fmt: skip
+                          rigid_wall=inputs.rigid_wall, friction=inputs.friction,
+                          seed=None if inputs.adapt is None else inputs.sizes.reach)  # fmt: skip
+    adapt = None
+    if inputs.adapt is not None:  # the block's patch from a seed at the contact
+        a = inputs.adapt
+        adapt = bodies.adaptation(a["adapt_threshold"], a["adapt_buffer"], a["adapt_every"],
+                                  a["max_patch_fraction"])  # fmt: skip
     values = _hertz_values(inputs, bodies)
     t_end = _simulated_time(inputs, bodies, values)
     record = config.inputs()  # the resolved inputs, the materials as objects of their fields
     folder = ResultsFolder(out, "arlequin ball-impact", record, config.units()) if out else None
     recorder = ImpactRecorder(bodies, folder, t_end, progress)
     with _failures_recorded(folder):
-        res, wall = _time_loop(inputs, bodies, recorder, folder, t_end)
+        res, wall = _time_loop(inputs, bodies, recorder, folder, t_end, adapt)
         # Arlequin: its patches' elements; a reference: all its elements, over the uniform
         # meshes'
         mono = mono_cells(inputs.sizes, inputs.block_radius, inputs.block_height,
@@ -61,6 +67,9 @@ def run_config(config: BallImpactConfig, out: str | Path | None = None,
         # still in contact at the end: a ValueError, and the folder says so
         result = recorder.result(res, wall, fine / mono, values, record)
     result.t_end = float(t_end)
+    if adapt is not None:
+        result.adaptations = [a.to_json() for a in res.adaptations]
+        result.max_coarse_yield_ratio = float(res.max_coarse_yield_ratio)
     _warn_band_plasticity(result, inputs)
     if folder is not None:
         write_outputs(folder, result, bodies, res)
@@ -127,16 +136,20 @@ def _integrator(inputs: ResolvedInputs, bodies: ImpactBodies) -> tuple[str, dict
 
 
 def _time_loop(inputs: ResolvedInputs, bodies: ImpactBodies, recorder: ImpactRecorder,
-               folder: ResultsFolder | None, t_end: float) -> tuple[Any, float]:  # fmt: skip
-    """The explicit run to ``t_end`` (s): its final state and its wall time (s)."""
+               folder: ResultsFolder | None, t_end: float,
+               adapt: Any = None) -> tuple[Any, float]:  # fmt: skip
+    """The explicit run to ``t_end`` (s): its final state and its wall time (s); ``adapt``
+    the adaptive block patch, if any."""
     frames = np.linspace(0.0, t_end, 11)[1:]
     writers = ([DynamicRunWriter(folder, bodies.system, layout=bodies.layout, frame_times=frames)]
                if folder else [])  # fmt: skip
     integrator, options = _integrator(inputs, bodies)
     tic = time.perf_counter()
-    res = solve(bodies.system, integrator, t_end=t_end,
+    # an adaptive patch rebuilds the problem (its body's patch), not only the system
+    res = solve(bodies.system if adapt is None else bodies.problem, integrator, t_end=t_end,
                 v0=bodies.initial_velocity(inputs.velocity), constraints=[bodies.contact],
-                on_step=[recorder], on_record=writers, t_eval=frames, **options)  # fmt: skip
+                on_step=[recorder], on_record=writers, t_eval=frames, adapt=adapt,
+                **options)  # fmt: skip
     return res, time.perf_counter() - tic
 
 

@@ -36,6 +36,8 @@ from ...models import (
     PlaneObstacle,
     RigidContactPair,
 )
+from ...problem.adapt import AdaptivePatch
+from ...problem.adapt_bodies import BodyAdaptation
 from ...problem.arlequin_problem import ArlequinProblem, Patch
 from ...problem.bodies import MultiBodyProblem
 from .meshes import GROWTH, ball_patch_mesh, block_mesh, block_patch_mesh, half_disk_mesh
@@ -108,7 +110,8 @@ class ResolvedInputs:
     materials, ``fine`` (the requested fine size before rounding, m), ``sizes`` (the rounded
     sizes and the patches' radii), ``coarse_step_ratio`` (M), and ``record``: the inputs
     recorded in ``results.json`` and the JSON (plain JSON, the materials as objects of their
-    named fields).
+    named fields); ``adapt``: the adaptive patch's options (``adapt_threshold``,
+    ``adapt_buffer``, ``adapt_every``, ``max_patch_fraction``), None for a fixed patch.
     """
 
     regime: str
@@ -126,6 +129,7 @@ class ResolvedInputs:
     coarse_step_ratio: int
     t_end: float | None
     record: dict[str, Any]
+    adapt: dict[str, Any] | None = None
 
     @property
     def plastic(self) -> bool:
@@ -164,12 +168,15 @@ class ImpactBodies:
         The ball against the rigid plane z = 0 instead of the block.
     friction : float
         Coulomb coefficient (0: frictionless).
+    seed : float, optional
+        The block patch's radius (m) when it adapts (the coarse mesh stays uniform to
+        ``sizes.block_patch``): the seed of :meth:`adaptation`.
     """
 
     def __init__(self, model: str, sizes: BallSizes, ball_radius: float, block_radius: float,
                  block_height: float, ball_material: IsotropicElastic,
                  block_material: IsotropicElastic | J2Material, rigid_wall: bool = False,
-                 friction: float = 0.0) -> None:  # fmt: skip
+                 friction: float = 0.0, seed: float | None = None) -> None:  # fmt: skip
         self.model = model
         self.sizes = s = sizes
         big = float(ball_radius)
@@ -194,7 +201,7 @@ class ImpactBodies:
             elastic = block_material.elastic if self.plastic else block_material
             if model == "arlequin":
                 bc = block_mesh(block_radius, block_height, s.coarse, uniform=s.block_patch)
-                bf = block_patch_mesh(bc, s.block_patch, s.levels)
+                bf = block_patch_mesh(bc, s.block_patch if seed is None else seed, s.levels)
                 bodies["block"] = self._pair(bc, bf, elastic, block_material)
                 self.meshes.update({"block.coarse": bc, "block.patch": bf})
             else:
@@ -214,55 +221,85 @@ class ImpactBodies:
             bodies["block"].add_dirichlet("coarse", lambda x: x[1] < -block_height + tol,
                                           components=[1])  # fmt: skip
         self.problem = MultiBodyProblem(bodies)
-        self.system = self.problem.system()
-        self.layout = self.problem.field_layout()
-        dm = self.system.dofmap
         contact_block = "patch" if model == "arlequin" else "coarse"
         self.ball_block = f"ball.{contact_block}"
         self.block_block = None if rigid_wall else f"block.{contact_block}"
-        zone = s.zone if model == "arlequin" else s.reach - s.gluing - s.coarse
-        self.zone = zone
-        ball_mesh = self.meshes[self.ball_block]
-
-        def on_ball(x):
-            return (np.hypot(x[0], x[1] - big) > big - 0.05 * s.fine) & (np.hypot(x[0], x[1])
-                                                                          < zone)  # fmt: skip
-
-        slave = ContactSurface(ball_mesh, where=on_ball, offset=dm[self.ball_block],
-                               axisymmetric=True)  # fmt: skip
-        if rigid_wall:
-            pair = RigidContactPair(slave, PlaneObstacle(np.zeros(2), np.array([0.0, 1.0])), dm)
-            contact_material = ball_material
-        else:
-            master = ContactSurface(self.meshes[self.block_block],
-                                    where=lambda x: (x[1] > -tol) & (x[0] < zone),
-                                    offset=dm[self.block_block], axisymmetric=True)  # fmt: skip
-            pair = DeformableContactPair(slave, master, dm)
-            # κ = η = the impedance ρc of the ball (LevelSetContact's default from a material)
-            contact_material = ball_material
-        self.pair = pair
-        if friction > 0:
-            self.contact = CoulombContact(pair, friction, material=contact_material, name="contact")
-        else:
-            self.contact = LevelSetContact(pair, material=contact_material, name="contact")
+        self.zone = s.zone if model == "arlequin" else s.reach - s.gluing - s.coarse
+        self._rigid, self._friction, self._ball_material = rigid_wall, friction, ball_material
+        self._bind(self.problem)
+        blocks = list(self.system.dofmap)
         self.slow_blocks = tuple(b for b in ("ball.coarse", "block.coarse")
-                                 if model == "arlequin" and b in list(dm))  # fmt: skip
+                                 if model == "arlequin" and b in blocks)  # fmt: skip
+
+    def _bind(self, problem: MultiBodyProblem) -> None:
+        """The system, layout, contact and measures of ``problem`` (this set-up's, or the one
+        an adaptive block patch grew to)."""
+        self.problem = problem
+        self.system = problem.system()
+        self.layout = problem.field_layout()
+        for name, body in problem.bodies.items():
+            if isinstance(body, ArlequinProblem) and body.patches:
+                self.meshes[f"{name}.patch"] = body.patches[0].model.mesh
+        self.contact = self.contact_for(problem)
+        dm = self.system.dofmap
         self._ball_z = np.concatenate([dm[b].component_dofs(1) for b in dm
                                        if b.startswith("ball.")])  # fmt: skip
         mass = np.asarray(self.system.mass(lumped=True))
         self._ball_mass = mass[self._ball_z]
         self.ball_mass = float(self._ball_mass.sum())
-        self.slave_r = slave.positions(np.zeros(dm.n_dofs))[0]
-        if not rigid_wall:
+        self.slave_r = self.pair.slave.positions(np.zeros(dm.n_dofs))[0]
+        if self.block_block is not None:
             bm = self.meshes[self.block_block]
-            self._pole = int(np.nonzero((bm.p[0] < tol) & (bm.p[1] > -tol))[0][0])
+            self._pole = int(np.nonzero((bm.p[0] < self.tol) & (bm.p[1] > -self.tol))[0][0])
         #: the block patch's cells in its gluing band (empty without an Arlequin block)
         self.band_cells = np.zeros(0, dtype=np.int64)
-        if model == "arlequin" and not rigid_wall:
-            self.band_cells = np.asarray(bodies["block"].couplings[0].fine_gluing_cells)
+        if self.model == "arlequin" and self.block_block is not None:
+            self.band_cells = np.asarray(problem.bodies["block"].couplings[0].fine_gluing_cells)
         self.n_elements = int(sum(m.nelements for m in self.meshes.values()))
         self.fine_elements = int(sum(m.nelements for k, m in self.meshes.items()
                                      if k.endswith(".patch")))  # fmt: skip
+
+    def contact_for(self, problem: MultiBodyProblem) -> Any:
+        """The contact between the bodies of ``problem`` (on its dof map): the ball's surface
+        nodes below its gluing band against the block's top facets below the band (or the
+        rigid plane). Also kept as :attr:`pair`."""
+        s, big, tol = self.sizes, self.radius, self.tol
+        dm = problem.system().dofmap
+        zone = self.zone
+        meshes = {f"{n}.patch": b.patches[0].model.mesh for n, b in problem.bodies.items()
+                  if isinstance(b, ArlequinProblem) and b.patches}  # fmt: skip
+        meshes = {**self.meshes, **meshes}
+
+        def on_ball(x):
+            return (np.hypot(x[0], x[1] - big) > big - 0.05 * s.fine) & (np.hypot(x[0], x[1])
+                                                                          < zone)  # fmt: skip
+
+        slave = ContactSurface(meshes[self.ball_block], where=on_ball, offset=dm[self.ball_block],
+                               axisymmetric=True)  # fmt: skip
+        if self._rigid:
+            pair = RigidContactPair(slave, PlaneObstacle(np.zeros(2), np.array([0.0, 1.0])), dm)
+        else:
+            master = ContactSurface(meshes[self.block_block],
+                                    where=lambda x: (x[1] > -tol) & (x[0] < zone),
+                                    offset=dm[self.block_block], axisymmetric=True)  # fmt: skip
+            pair = DeformableContactPair(slave, master, dm)
+        # κ = η = the impedance ρc of the ball (LevelSetContact's default from a material)
+        self.pair = pair
+        if self._friction > 0:
+            return CoulombContact(pair, self._friction, material=self._ball_material,
+                                  name="contact")  # fmt: skip
+        return LevelSetContact(pair, material=self._ball_material, name="contact")
+
+    def regrow(self, problem: MultiBodyProblem) -> None:
+        """Follow an adaptive block patch that grew: ``problem`` is the new set-up."""
+        self._bind(problem)
+
+    def adaptation(self, threshold: float, buffer: int, every: int, max_fraction: float) -> Any:
+        """The adaptive block patch (:class:`~arlequin.problem.adapt_bodies.BodyAdaptation`
+        of an :class:`~arlequin.AdaptivePatch`), its contact rebuilt on each grown problem."""
+        patch = AdaptivePatch(threshold=threshold, buffer=buffer, every=every,
+                              max_fraction=max_fraction)  # fmt: skip
+        return BodyAdaptation(patch, "block", constraints=lambda p: [self.contact_for(p)])
 
     def _pair(self, cmesh, fmesh, coarse_material, fine_material) -> ArlequinProblem:
         coarse = LinearElastic(cmesh, coarse_material, kind="axisymmetric")
