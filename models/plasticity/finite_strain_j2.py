@@ -25,6 +25,7 @@ every integrand.
 
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass
 
 import numpy as np
@@ -71,6 +72,25 @@ class BulkViscosity:
             v = getattr(self, name)
             if not (np.isfinite(v) and v >= 0.0):
                 raise ValueError(f"bulk viscosity coefficient {name} must be >= 0, got {v}")
+
+
+#: State-array sets kept for reuse by the compiled path (an integrator holds two states at once:
+#: the committed one and the trial; a third for a caller that keeps one more).
+_STATE_POOL_SIZE = 3
+
+
+def _max_refs(arrays: list[np.ndarray]) -> int:
+    return max(sys.getrefcount(a) for a in arrays)
+
+
+# the count of an array referenced only by its list (and this check's own references),
+# measured rather than assumed: it differs between Python versions
+_FREE_REFS = _max_refs([np.empty(1)])
+
+
+def _unreferenced(arrays: list[np.ndarray]) -> bool:
+    """True when nothing but ``arrays`` itself holds any of them (no state, no view)."""
+    return _max_refs(arrays) <= _FREE_REFS
 
 
 class FiniteStrainJ2:
@@ -153,6 +173,8 @@ class FiniteStrainJ2:
         self._alpha_of: tuple | None = None  # (read-only weight, its checked broadcast)
         self._assembler = None  # the tangent's sparse pattern, built at the first call
         self._tangent_static: tuple | None = None  # the tangent kernel's inputs and scratch
+        self._cell_buffers: tuple | None = None  # the kernels' per-cell forces and flags
+        self._state_pool: list[list[np.ndarray]] = []  # state arrays, reused once unreferenced
 
     def _measure_factor(self) -> np.ndarray:
         if self.kind == "axisymmetric":
@@ -388,7 +410,7 @@ class FiniteStrainJ2:
     def _internal_force_numba(self, u, state, alpha, dt):
         if self.dim == 3:
             return self._internal_force_numba_3d(u, state, alpha, dt)
-        from .j2_kernel import planar_j2_kernel, scratch
+        from .j2_kernel import planar_j2_kernel, run_kernel, scratch
 
         kin = self.kin
         ne, nq = self.shape
@@ -410,8 +432,9 @@ class FiniteStrainJ2:
         c = np.ascontiguousarray
         # the weight goes in as a read-only broadcast view whatever its source: one type to
         # numba, the one warm_up compiles
-        planar_j2_kernel(
-            u, dofs, grad, val, radius, dv0, c(np.broadcast_to(alpha, (ne, nq)), dtype=float),
+        weight = c(np.broadcast_to(alpha, (ne, nq)), dtype=float)
+        run_kernel(
+            planar_j2_kernel, ne, u, dofs, grad, val, radius, dv0, weight,
             self.kind == "axisymmetric", self.fbar, self.material.bulk_modulus,
             self.material.shear_modulus, int(law.kernel_code), law.kernel_params,
             -1.0 if dt is None else float(dt), c(state.cp_inv), c(state.eqps),
@@ -421,6 +444,7 @@ class FiniteStrainJ2:
         return self._gathered(out)
 
     def _internal_force_numba_3d(self, u, state, alpha, dt):
+        from .j2_kernel import run_kernel
         from .j2_kernel_3d import solid_j2_kernel, solid_scratch
 
         kin = self.kin
@@ -438,12 +462,13 @@ class FiniteStrainJ2:
         u = self._checked_displacement(u)
         out = self._kernel_outputs(3)
         # the weight as a read-only broadcast view, the type warm_up_solid compiles
-        solid_j2_kernel(
-            u, dofs, grad, dv0, c(np.broadcast_to(alpha, (ne, nq)), dtype=float), self.fbar,
-            self.material.bulk_modulus, self.material.shear_modulus, int(law.kernel_code),
-            law.kernel_params, -1.0 if dt is None else float(dt), c(state.cp_inv),
-            c(state.eqps), c(state.plastic_work), c(state.viscous_work), c(state.jacobian),
-            visc, h0, s_h, s_g, s_m, *out,
+        weight = c(np.broadcast_to(alpha, (ne, nq)), dtype=float)
+        run_kernel(
+            solid_j2_kernel, ne, u, dofs, grad, dv0, weight, self.fbar, self.material.bulk_modulus,
+            self.material.shear_modulus, int(law.kernel_code), law.kernel_params,
+            -1.0 if dt is None else float(dt), c(state.cp_inv), c(state.eqps),
+            c(state.plastic_work), c(state.viscous_work), c(state.jacobian), visc, h0,
+            s_h, s_g, s_m, *out,
         )  # fmt: skip
         return self._gathered(out)
 
@@ -463,12 +488,28 @@ class FiniteStrainJ2:
         return u
 
     def _kernel_outputs(self, dim: int) -> list[np.ndarray]:
-        """The kernels' output buffers: forces, C_p⁻¹, ε̄p, τ, J, works, flags."""
+        """The kernels' output buffers: forces, C_p⁻¹, ε̄p, τ, J, works, flags.
+
+        The per-cell forces and flags are the model's own (they never leave it). The state's
+        arrays come from a small pool: a set that nothing outside the pool references any more
+        (the states that held it are gone) is written over rather than allocated afresh. New
+        arrays are new pages: about 1,000 page faults per evaluation at nr = 30 (7 MB), which
+        cost as much as the kernel itself on the 2-core test machine.
+        """
         ne, nq = self.shape
         nen = self.kin.grad.shape[0]
-        return [np.empty((dim, nen, ne)), np.empty((3, 3, ne, nq)), np.empty((ne, nq)),
-                np.empty((3, 3, ne, nq)), np.empty((ne, nq)), np.empty((ne, nq)),
-                np.empty((ne, nq)), np.empty(ne, dtype=np.int64)]  # fmt: skip
+        if self._cell_buffers is None or self._cell_buffers[0].shape[0] != dim:
+            self._cell_buffers = (np.empty((dim, nen, ne)), np.empty(ne, dtype=np.int64))
+        fe, flags = self._cell_buffers
+        for arrays in self._state_pool:
+            if _unreferenced(arrays):
+                break
+        else:
+            arrays = [np.empty((3, 3, ne, nq)), np.empty((ne, nq)), np.empty((3, 3, ne, nq)),
+                      np.empty((ne, nq)), np.empty((ne, nq)), np.empty((ne, nq))]  # fmt: skip
+            if len(self._state_pool) < _STATE_POOL_SIZE:
+                self._state_pool.append(arrays)
+        return [fe, *arrays, flags]
 
     def _gathered(self, out: list[np.ndarray]):
         """The kernel's outputs as (nodal force, PlasticState); flagged cells raise."""
