@@ -175,6 +175,8 @@ class FiniteStrainJ2:
         self._tangent_static: tuple | None = None  # the tangent kernel's inputs and scratch
         self._cell_buffers: tuple | None = None  # the kernels' per-cell forces and flags
         self._state_pool: list[list[np.ndarray]] = []  # state arrays, reused once unreferenced
+        self._constants: tuple | None = None  # K, G, law code and parameters of the kernels
+        self._kernel_weight: tuple | None = None  # (α, its read-only view for the kernels)
 
     def _measure_factor(self) -> np.ndarray:
         if self.kind == "axisymmetric":
@@ -415,7 +417,6 @@ class FiniteStrainJ2:
         kin = self.kin
         ne, nq = self.shape
         nen = kin.grad.shape[0]
-        law = self.material.law
         if self._kernel_static is None:
             c = np.ascontiguousarray
             radius = kin.radius if kin.radius is not None else np.ones((ne, nq))
@@ -430,13 +431,10 @@ class FiniteStrainJ2:
         u = self._checked_displacement(u)
         out = self._kernel_outputs(2)
         c = np.ascontiguousarray
-        # the weight goes in as a read-only broadcast view whatever its source: one type to
-        # numba, the one warm_up compiles
-        weight = c(np.broadcast_to(alpha, (ne, nq)), dtype=float)
+        weight, K, G, code, prm = self._kernel_constants(alpha)
         run_kernel(
             planar_j2_kernel, ne, u, dofs, grad, val, radius, dv0, weight,
-            self.kind == "axisymmetric", self.fbar, self.material.bulk_modulus,
-            self.material.shear_modulus, int(law.kernel_code), law.kernel_params,
+            self.kind == "axisymmetric", self.fbar, K, G, code, prm,
             -1.0 if dt is None else float(dt), c(state.cp_inv), c(state.eqps),
             c(state.plastic_work), c(state.viscous_work), c(state.jacobian), visc, h0,
             s_h, s_g, s_u, *out,
@@ -450,7 +448,6 @@ class FiniteStrainJ2:
         kin = self.kin
         ne, nq = self.shape
         nen = kin.grad.shape[0]
-        law = self.material.law
         c = np.ascontiguousarray
         if self._kernel_static is None:
             self._kernel_static = (
@@ -461,16 +458,33 @@ class FiniteStrainJ2:
         dofs, grad, dv0, visc, h0, s_h, s_g, s_m = self._kernel_static
         u = self._checked_displacement(u)
         out = self._kernel_outputs(3)
-        # the weight as a read-only broadcast view, the type warm_up_solid compiles
-        weight = c(np.broadcast_to(alpha, (ne, nq)), dtype=float)
+        weight, K, G, code, prm = self._kernel_constants(alpha)
         run_kernel(
-            solid_j2_kernel, ne, u, dofs, grad, dv0, weight, self.fbar, self.material.bulk_modulus,
-            self.material.shear_modulus, int(law.kernel_code), law.kernel_params,
+            solid_j2_kernel, ne, u, dofs, grad, dv0, weight, self.fbar, K, G, code, prm,
             -1.0 if dt is None else float(dt), c(state.cp_inv), c(state.eqps),
             c(state.plastic_work), c(state.viscous_work), c(state.jacobian), visc, h0,
             s_h, s_g, s_m, *out,
         )  # fmt: skip
         return self._gathered(out)
+
+    def _kernel_constants(self, alpha: np.ndarray) -> tuple:
+        """The kernels' weight (n_elems, n_qp) and material constants K, G (Pa), law code and
+        parameters, made once: the material is frozen, and the weight is the same object at
+        every step unless the caller passes a new writeable array (a property chain and a
+        broadcast per call were a third of a small patch's evaluation)."""
+        if self._constants is None:
+            law = self.material.law
+            self._constants = (self.material.bulk_modulus, self.material.shear_modulus,
+                               int(law.kernel_code), law.kernel_params)  # fmt: skip
+        if self._kernel_weight is None or self._kernel_weight[0] is not alpha:
+            # a read-only broadcast view whatever its source: one type to numba, the one the
+            # warm-ups compile
+            ne, nq = self.shape
+            weight = np.ascontiguousarray(np.broadcast_to(alpha, (ne, nq)), dtype=float)
+            if alpha is not self._ones and alpha.flags.writeable:
+                return (weight, *self._constants)  # the caller's array: it may change
+            self._kernel_weight = (alpha, weight)
+        return (self._kernel_weight[1], *self._constants)
 
     def _viscosity_params(self) -> np.ndarray:
         """(c_linear, c_quadratic, ρ₀, c_d) of the bulk viscosity for the kernels (0: off)."""
