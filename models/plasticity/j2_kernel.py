@@ -1,12 +1,13 @@
 """The compiled kernel of finite-strain J2 on planar Q1 cells (axisymmetric, plane strain).
 
-One fused pass per cell, parallel over the cells (numba ``prange``): deformation gradient at
+One fused pass per cell, parallel over the cells (numba ``prange``; on the calling thread alone
+below :data:`PARALLEL_MIN_CELLS`, see :func:`run_kernel`): deformation gradient at
 the four Gauss points, the cell's mean dilatation (F-bar), the exponential-map return of
 :mod:`arlequin.models.plasticity.j2` (closed-form principal axes in the (r, z) plane plus the hoop
 or out-of-plane axis), the optional bulk viscosity, and the consistent internal force of
 :mod:`arlequin.models.plasticity.kinematics`, written into preallocated per-cell buffers (no race:
 the nodal forces are summed afterwards with ``np.bincount``). It is the numpy reference path
-computed point by point, compared with it to 1e-12 (``tests/test_j2_kernel.py``).
+computed point by point, compared with it to 1e-13 (``tests/test_j2_kernel.py``).
 
 Hardening laws by code (see :mod:`arlequin.models.plasticity.hardening`): 0 linear (σ_y0, H), 1 Voce
 (σ_y0, Q, b, H), 2 Johnson–Cook (A, B, n, C, ε̄̇0, ε̄p floor).
@@ -26,20 +27,21 @@ __all__ = ["PARALLEL_MIN_CELLS", "planar_j2_kernel", "run_kernel", "scratch", "w
 
 SQRT23 = math.sqrt(2.0 / 3.0)
 
-#: Below this many cells a kernel runs on the calling thread alone. A cell costs about 0.5 µs
-#: (2D) to 3 µs (3D) on one core; waking the sleeping worker threads
-#: (``OMP_WAIT_POLICY=PASSIVE``) and joining them costs tens of µs, more on a loaded machine,
-#: so that small patches ran slower on two threads than on one.
+#: Below this many cells a kernel runs on the calling thread alone. A planar cell costs about
+#: 0.5 µs on one core (a hexahedron 3 µs); waking the sleeping worker threads
+#: (``OMP_WAIT_POLICY=PASSIVE``) and joining them costs tens of µs: on the 2-core machine, loaded
+#: by other work, two threads ran a 16-cell patch at 0.63 times the speed of one and a 64-cell
+#: patch at 0.91. 256 cells (about 130 µs of work) leave the wake-up a small share.
 PARALLEL_MIN_CELLS = 256
 
 
 def run_kernel(kernel, n_cells: int, *args) -> None:
     """Call ``kernel(*args)``, on the calling thread alone when ``n_cells`` is below
     :data:`PARALLEL_MIN_CELLS` (numba's thread count is per calling thread and restored)."""
-    if n_cells >= PARALLEL_MIN_CELLS:
+    n = nb.get_num_threads()
+    if n_cells >= PARALLEL_MIN_CELLS or n == 1:
         kernel(*args)
         return
-    n = nb.get_num_threads()
     nb.set_num_threads(1)
     try:
         kernel(*args)

@@ -7,7 +7,7 @@ cancellation, the cell's mean dilatation (F-bar), b_e − 1 = H + Hᵀ + H Hᵀ 
 eigen-decomposition (cyclic Jacobi rotations on the 3 × 3 matrix, to round-off: the principal axes
 are no longer known as in the planar case), the exponential-map radial return, the optional bulk
 viscosity and the consistent internal force with the F-bar pressure term. Compared with the numpy
-path to 1e-12 (``tests/test_j2_kernel.py``).
+path to 1e-13 (``tests/test_j2_kernel.py``).
 
 The hardening laws and the plastic multiplier are those of
 :mod:`arlequin.models.plasticity.j2_kernel`. numba compiles on first call (cached on disk);
