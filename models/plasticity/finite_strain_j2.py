@@ -83,14 +83,9 @@ def _max_refs(arrays: list[np.ndarray]) -> int:
     return max(sys.getrefcount(a) for a in arrays)
 
 
-# the count of an array referenced only by its list (and this check's own references),
-# measured rather than assumed: it differs between Python versions
+# references to an array held only by its list (and by this check), measured: it varies
+# between Python versions. A set is free when no array of it has more (no state, no view).
 _FREE_REFS = _max_refs([np.empty(1)])
-
-
-def _unreferenced(arrays: list[np.ndarray]) -> bool:
-    """True when nothing but ``arrays`` itself holds any of them (no state, no view)."""
-    return _max_refs(arrays) <= _FREE_REFS
 
 
 class FiniteStrainJ2:
@@ -516,7 +511,7 @@ class FiniteStrainJ2:
             self._cell_buffers = (np.empty((dim, nen, ne)), np.empty(ne, dtype=np.int64))
         fe, flags = self._cell_buffers
         for arrays in self._state_pool:
-            if _unreferenced(arrays):
+            if _max_refs(arrays) <= _FREE_REFS:
                 break
         else:
             arrays = [np.empty((3, 3, ne, nq)), np.empty((ne, nq)), np.empty((3, 3, ne, nq)),
