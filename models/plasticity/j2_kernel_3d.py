@@ -32,9 +32,11 @@ def _rotate(app, aqq, apq, arp, arq, v0p, v1p, v2p, v0q, v1q, v2q):
     the new a_pp, a_qq, a_rp, a_rq and the columns p and q of V J."""
     if apq == 0.0:
         return app, aqq, arp, arq, v0p, v1p, v2p, v0q, v1q, v2q
-    theta = (aqq - app) / (2.0 * apq)
-    t = 1.0 / (abs(theta) + math.sqrt(theta * theta + 1.0))
-    if theta < 0.0:
+    # t = tan φ = sgn θ / (|θ| + √(θ² + 1)), θ = (a_qq − a_pp) / 2a_pq, without forming θ:
+    # one division less on the sweeps' critical path (6% of the 3D kernel)
+    d = aqq - app
+    t = 2.0 * abs(apq) / (abs(d) + math.sqrt(d * d + 4.0 * apq * apq))
+    if d != 0.0 and (d < 0.0) != (apq < 0.0):
         t = -t
     c = 1.0 / math.sqrt(t * t + 1.0)
     s = t * c
