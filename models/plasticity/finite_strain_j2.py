@@ -34,6 +34,7 @@ from skfem import Basis, Mesh
 from arlequin.contract import CellStates, StateError
 
 from ..elastic import LinearElastic, WeightLike, element_critical_step
+from .array_pool import ArrayPool
 from .j2 import (
     InvertedElementError,
     J2Material,
@@ -153,6 +154,10 @@ class FiniteStrainJ2(CellStates):
         self._alpha_of: tuple | None = None  # (read-only weight, its checked broadcast)
         self._assembler = None  # the tangent's sparse pattern, built at the first call
         self._tangent_static: tuple | None = None  # the tangent kernel's inputs and scratch
+        self._cell_buffers: tuple | None = None  # the kernels' per-cell forces and flags
+        self._state_pool = ArrayPool()  # state arrays, reused once unreferenced
+        self._constants: tuple | None = None  # K, G, law code and parameters of the kernels
+        self._kernel_weight: tuple | None = None  # (α, its read-only view for the kernels)
 
     def _measure_factor(self) -> np.ndarray:
         if self.kind == "axisymmetric":
@@ -398,12 +403,11 @@ class FiniteStrainJ2(CellStates):
     def _internal_force_numba(self, u, state, alpha, dt):
         if self.dim == 3:
             return self._internal_force_numba_3d(u, state, alpha, dt)
-        from .j2_kernel import planar_j2_kernel, scratch
+        from .j2_kernel import planar_j2_kernel, run_kernel, scratch
 
         kin = self.kin
         ne, nq = self.shape
         nen = kin.grad.shape[0]
-        law = self.material.law
         if self._kernel_static is None:
             c = np.ascontiguousarray
             radius = kin.radius if kin.radius is not None else np.ones((ne, nq))
@@ -418,12 +422,10 @@ class FiniteStrainJ2(CellStates):
         u = self._checked_displacement(u)
         out = self._kernel_outputs(2)
         c = np.ascontiguousarray
-        # the weight goes in as a read-only broadcast view whatever its source: one type to
-        # numba, the one warm_up compiles
-        planar_j2_kernel(
-            u, dofs, grad, val, radius, dv0, c(np.broadcast_to(alpha, (ne, nq)), dtype=float),
-            self.kind == "axisymmetric", self.fbar, self.material.bulk_modulus,
-            self.material.shear_modulus, int(law.kernel_code), law.kernel_params,
+        weight, K, G, code, prm = self._kernel_constants(alpha)
+        run_kernel(
+            planar_j2_kernel, ne, u, dofs, grad, val, radius, dv0, weight,
+            self.kind == "axisymmetric", self.fbar, K, G, code, prm,
             -1.0 if dt is None else float(dt), c(state.cp_inv), c(state.eqps),
             c(state.plastic_work), c(state.viscous_work), c(state.jacobian), visc, h0,
             s_h, s_g, s_u, *out,
@@ -431,12 +433,12 @@ class FiniteStrainJ2(CellStates):
         return self._gathered(out)
 
     def _internal_force_numba_3d(self, u, state, alpha, dt):
+        from .j2_kernel import run_kernel
         from .j2_kernel_3d import solid_j2_kernel, solid_scratch
 
         kin = self.kin
         ne, nq = self.shape
         nen = kin.grad.shape[0]
-        law = self.material.law
         c = np.ascontiguousarray
         if self._kernel_static is None:
             self._kernel_static = (
@@ -447,15 +449,33 @@ class FiniteStrainJ2(CellStates):
         dofs, grad, dv0, visc, h0, s_h, s_g, s_m = self._kernel_static
         u = self._checked_displacement(u)
         out = self._kernel_outputs(3)
-        # the weight as a read-only broadcast view, the type warm_up_solid compiles
-        solid_j2_kernel(
-            u, dofs, grad, dv0, c(np.broadcast_to(alpha, (ne, nq)), dtype=float), self.fbar,
-            self.material.bulk_modulus, self.material.shear_modulus, int(law.kernel_code),
-            law.kernel_params, -1.0 if dt is None else float(dt), c(state.cp_inv),
-            c(state.eqps), c(state.plastic_work), c(state.viscous_work), c(state.jacobian),
-            visc, h0, s_h, s_g, s_m, *out,
+        weight, K, G, code, prm = self._kernel_constants(alpha)
+        run_kernel(
+            solid_j2_kernel, ne, u, dofs, grad, dv0, weight, self.fbar, K, G, code, prm,
+            -1.0 if dt is None else float(dt), c(state.cp_inv), c(state.eqps),
+            c(state.plastic_work), c(state.viscous_work), c(state.jacobian), visc, h0,
+            s_h, s_g, s_m, *out,
         )  # fmt: skip
         return self._gathered(out)
+
+    def _kernel_constants(self, alpha: np.ndarray) -> tuple:
+        """The kernels' weight (n_elems, n_qp) and material constants K, G (Pa), law code and
+        parameters, made once: the material is frozen, and the weight is the same object at
+        every step unless the caller passes a new writeable array (a property chain and a
+        broadcast per call were a third of a small patch's evaluation)."""
+        if self._constants is None:
+            law = self.material.law
+            self._constants = (self.material.bulk_modulus, self.material.shear_modulus,
+                               int(law.kernel_code), law.kernel_params)  # fmt: skip
+        if self._kernel_weight is None or self._kernel_weight[0] is not alpha:
+            # a read-only broadcast view whatever its source: one type to numba, the one the
+            # warm-ups compile
+            ne, nq = self.shape
+            weight = np.ascontiguousarray(np.broadcast_to(alpha, (ne, nq)), dtype=float)
+            if alpha is not self._ones and alpha.flags.writeable:
+                return (weight, *self._constants)  # the caller's array: it may change
+            self._kernel_weight = (alpha, weight)
+        return (self._kernel_weight[1], *self._constants)
 
     def _viscosity_params(self) -> np.ndarray:
         """(c_linear, c_quadratic, ρ₀, c_d) of the bulk viscosity for the kernels (0: off)."""
@@ -473,12 +493,22 @@ class FiniteStrainJ2(CellStates):
         return u
 
     def _kernel_outputs(self, dim: int) -> list[np.ndarray]:
-        """The kernels' output buffers: forces, C_p⁻¹, ε̄p, τ, J, works, flags."""
+        """The kernels' output buffers: forces, C_p⁻¹, ε̄p, τ, J, works, flags.
+
+        The per-cell forces and flags are the model's own (they never leave it). The state's
+        arrays come from a small pool: a set that nothing outside the pool references any more
+        (the states that held it are gone) is written over rather than allocated afresh. New
+        arrays are new pages: about 1,000 page faults per evaluation at nr = 30 (7 MB), which
+        cost as much as the kernel itself on the 2-core test machine.
+        """
         ne, nq = self.shape
         nen = self.kin.grad.shape[0]
-        return [np.empty((dim, nen, ne)), np.empty((3, 3, ne, nq)), np.empty((ne, nq)),
-                np.empty((3, 3, ne, nq)), np.empty((ne, nq)), np.empty((ne, nq)),
-                np.empty((ne, nq)), np.empty(ne, dtype=np.int64)]  # fmt: skip
+        if self._cell_buffers is None or self._cell_buffers[0].shape[0] != dim:
+            self._cell_buffers = (np.empty((dim, nen, ne)), np.empty(ne, dtype=np.int64))
+        fe, flags = self._cell_buffers
+        arrays = self._state_pool.take([(3, 3, ne, nq), (ne, nq), (3, 3, ne, nq)]
+                                       + [(ne, nq)] * 3)  # fmt: skip
+        return [fe, *arrays, flags]
 
     def _gathered(self, out: list[np.ndarray]):
         """The kernel's outputs as (nodal force, PlasticState); flagged cells raise."""

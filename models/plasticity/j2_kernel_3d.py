@@ -7,7 +7,7 @@ cancellation, the cell's mean dilatation (F-bar), b_e − 1 = H + Hᵀ + H Hᵀ 
 eigen-decomposition (cyclic Jacobi rotations on the 3 × 3 matrix, to round-off: the principal axes
 are no longer known as in the planar case), the exponential-map radial return, the optional bulk
 viscosity and the consistent internal force with the F-bar pressure term. Compared with the numpy
-path to 1e-12 (``tests/test_j2_kernel.py``).
+path to 1e-13 (``tests/test_j2_kernel.py``).
 
 The hardening laws and the plastic multiplier are those of
 :mod:`arlequin.models.plasticity.j2_kernel`. numba compiles on first call (cached on disk);
@@ -27,45 +27,61 @@ __all__ = ["solid_j2_kernel", "solid_scratch", "warm_up_solid"]
 
 
 @nb.njit(cache=True, inline="always", error_model="numpy")
+def _rotate(app, aqq, apq, arp, arq, v0p, v1p, v2p, v0q, v1q, v2q):
+    """One Jacobi rotation J(p, q) that zeroes a_pq of a symmetric 3 × 3 (r: the third index):
+    the new a_pp, a_qq, a_rp, a_rq and the columns p and q of V J."""
+    if apq == 0.0:
+        return app, aqq, arp, arq, v0p, v1p, v2p, v0q, v1q, v2q
+    # t = tan φ = sgn θ / (|θ| + √(θ² + 1)), θ = (a_qq − a_pp) / 2a_pq, without forming θ:
+    # one division less on the sweeps' critical path (6% of the 3D kernel)
+    d = aqq - app
+    t = 2.0 * abs(apq) / (abs(d) + math.sqrt(d * d + 4.0 * apq * apq))
+    if d != 0.0 and (d < 0.0) != (apq < 0.0):
+        t = -t
+    c = 1.0 / math.sqrt(t * t + 1.0)
+    s = t * c
+    return (app - t * apq, aqq + t * apq, c * arp - s * arq, s * arp + c * arq,
+            c * v0p - s * v0q, c * v1p - s * v1q, c * v2p - s * v2q,
+            s * v0p + c * v0q, s * v1p + c * v1q, s * v2p + c * v2q)  # fmt: skip
+
+
+@nb.njit(cache=True, inline="always", error_model="numpy")
 def _jacobi3(a, v):
-    """Eigen-decomposition of the symmetric 3 × 3 ``a`` in place: on return its diagonal holds
-    the eigenvalues and the columns of ``v`` the unit eigenvectors (cyclic Jacobi)."""
-    for i in range(3):
-        for j in range(3):
-            v[i, j] = 1.0 if i == j else 0.0
+    """Eigen-decomposition of the symmetric 3 × 3 ``a`` (its upper triangle is read): on
+    return its diagonal holds the eigenvalues and the columns of ``v`` the unit eigenvectors
+    (cyclic Jacobi). The sweeps run on scalars (six entries of ``a``, nine of ``v``): on the
+    arrays they took a third of the 3D kernel's time."""
+    a00, a11, a22 = a[0, 0], a[1, 1], a[2, 2]
+    a01, a02, a12 = a[0, 1], a[0, 2], a[1, 2]
+    v00, v01, v02 = 1.0, 0.0, 0.0
+    v10, v11, v12 = 0.0, 1.0, 0.0
+    v20, v21, v22 = 0.0, 0.0, 1.0
     for _ in range(30):
-        off = a[0, 1] * a[0, 1] + a[0, 2] * a[0, 2] + a[1, 2] * a[1, 2]
-        scale = a[0, 0] * a[0, 0] + a[1, 1] * a[1, 1] + a[2, 2] * a[2, 2] + 2.0 * off
+        off = a01 * a01 + a02 * a02 + a12 * a12
+        scale = a00 * a00 + a11 * a11 + a22 * a22 + 2.0 * off
         if off <= 1e-36 * scale:
-            return
-        for p in range(2):
-            for q in range(p + 1, 3):
-                apq = a[p, q]
-                if apq == 0.0:
-                    continue
-                theta = (a[q, q] - a[p, p]) / (2.0 * apq)
-                t = 1.0 / (abs(theta) + math.sqrt(theta * theta + 1.0))
-                if theta < 0.0:
-                    t = -t
-                c = 1.0 / math.sqrt(t * t + 1.0)
-                s = t * c
-                for k in range(3):  # A J
-                    akp = a[k, p]
-                    akq = a[k, q]
-                    a[k, p] = c * akp - s * akq
-                    a[k, q] = s * akp + c * akq
-                for k in range(3):  # Jᵀ (A J)
-                    apk = a[p, k]
-                    aqk = a[q, k]
-                    a[p, k] = c * apk - s * aqk
-                    a[q, k] = s * apk + c * aqk
-                a[p, q] = 0.0
-                a[q, p] = 0.0
-                for k in range(3):  # V J
-                    vkp = v[k, p]
-                    vkq = v[k, q]
-                    v[k, p] = c * vkp - s * vkq
-                    v[k, q] = s * vkp + c * vkq
+            break
+        # (p, q) = (0, 1), r = 2
+        a00, a11, a02, a12, v00, v10, v20, v01, v11, v21 = _rotate(
+            a00, a11, a01, a02, a12, v00, v10, v20, v01, v11, v21
+        )
+        a01 = 0.0
+        # (p, q) = (0, 2), r = 1
+        a00, a22, a01, a12, v00, v10, v20, v02, v12, v22 = _rotate(
+            a00, a22, a02, a01, a12, v00, v10, v20, v02, v12, v22
+        )
+        a02 = 0.0
+        # (p, q) = (1, 2), r = 0
+        a11, a22, a01, a02, v01, v11, v21, v02, v12, v22 = _rotate(
+            a11, a22, a12, a01, a02, v01, v11, v21, v02, v12, v22
+        )
+        a12 = 0.0
+    a[0, 0], a[1, 1], a[2, 2] = a00, a11, a22
+    a[0, 1], a[0, 2], a[1, 2] = a01, a02, a12
+    a[1, 0], a[2, 0], a[2, 1] = a01, a02, a12
+    v[0, 0], v[0, 1], v[0, 2] = v00, v01, v02
+    v[1, 0], v[1, 1], v[1, 2] = v10, v11, v12
+    v[2, 0], v[2, 1], v[2, 2] = v20, v21, v22
 
 
 @nb.njit(parallel=True, cache=True, error_model="numpy", fastmath={"contract"})
