@@ -1,130 +1,140 @@
-"""Cost of one explicit coupled step against one step of each model alone (same run).
+"""The explicit step's time split into compiled kernels, linear algebra and the rest (overhead).
 
-A plane-strain cantilever (4 m × 1 m) with a coarse triangle mesh of size h = 1/64 m and a
-non-nested refined patch (size h/2, jittered nodes) on [0, 1.5] m at the clamped end: about 33k
-coarse and 49k fine elements, glued (H1, coarse mediator, ramp weights) in a band of
-``--gluing-elements`` coarse elements (default 4) along the patch's interior edge. The same
-central-difference integrator steps
+Runs a short window of a demo with the library's step timers on
+(:class:`arlequin.solvers.timing.StepTimer`: ``time.perf_counter`` around the models' internal
+forces, around the sparse/dense products and solves, and around each whole step; no profiler)
+and prints JSON: steps, steps per second, the seconds of the steps in kernels, in linear algebra
+and in the rest, the overhead's share of the step, the elements, the wall time of the run and the
+process's peak resident memory. The first step of a run (the integrator's lazy set-up: the
+critical step's eigenvalue estimate, the first factorisations) is timed apart
+(``first_step_seconds``) and left out of the other figures. The case runs once untimed first
+(the kernels' compilation or cache load); with ``--repeat N`` it runs N times and the round
+with the shortest step time is reported (all rounds' step times in ``step_seconds_all``).
 
-* the coupled system (mediator rows, Dirichlet rows on both models),
-* the fine patch alone (its own mesh, weight 1, clamped),
-* the coarse model alone (clamped),
+Cases (the demos' defaults, Arlequin models):
 
-all at the coupled system's default step, and the wall time spent in the coupling impulses
-(the transfers B v and M⁻¹Bᵀ Λ plus the triangular solves with the factorised B M⁻¹ Bᵀ) is measured
-inside the coupled steps (the constraint rows include the clamps of both models). Times are the
-best of 5 repeats of ``--steps`` steps (mean per step), the overhead that of the same repeat.
-Prints JSON (times in seconds per step).
+* ``taylor-2d``: the axisymmetric Arlequin Taylor bar (``arlequin taylor-bar``) to ``--t-end``
+  (default 20 µs of its 80 µs);
+* ``taylor-3d``: the quarter bar of hexahedra (``--geometry 3d``) to ``--t-end`` (default 5 µs);
+* ``ball``: the plastic ball impact (``arlequin ball-impact --regime plastic``, multi-time-step
+  as by default) to ``--t-end`` (default 15 µs, in contact: the demo's summary, refused
+  before the ball leaves, is not made);
+* ``ball-1``: the same without multi-time-step (``--coarse-step-ratio 1``).
 
-    python benchmarks/explicit_step.py [--h 0.015625] [--steps 300] [--json PATH]
+    python benchmarks/explicit_step.py [--case taylor-2d] [--repeat N] [--t-end T] [--clock thread]
+
+``--clock thread`` times with the main thread's CPU time (``time.thread_time``): on a machine
+shared with other jobs the Python layer's own cost, without the waits for a core (the kernels'
+other threads are not counted, so ``kernel_seconds`` is then the main thread's share).
+
+The coupled step against the models alone on a cantilever is ``benchmarks/coupling_overhead.py``.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
-import logging
+import resource
 import sys
 import time
 
-import numpy as np
+import _threads  # before numba runs: OpenMP threads sleep between parallel regions
 
-from arlequin.demos.cantilever import build_cantilever
-from arlequin.problem.system import Block, BlockTerm, CoupledSystem, LinearConstraint
-from arlequin.solvers import CentralDifference
-
-logger = logging.getLogger("explicit_step")
+CASES = ("taylor-2d", "taylor-3d", "ball", "ball-1")
+DEFAULT_T_END = {"taylor-2d": 20e-6, "taylor-3d": 5e-6, "ball": 15e-6, "ball-1": 15e-6}
 
 
-def _alone(model, name: str) -> CoupledSystem:
-    dofs = model.dofs_where(lambda x: x[0] < 1e-9)
-    import scipy.sparse as sp
+def _run(case: str, t_end: float):
+    """One run of ``case`` to ``t_end`` (s): (its result, its element count)."""
+    if case.startswith("taylor"):
+        from arlequin.demos.taylor_bar import run_taylor_bar
 
-    rows = sp.csr_matrix(
-        (np.ones(dofs.size), (np.arange(dofs.size), dofs)), shape=(dofs.size, model.n_dofs)
-    )
-    return CoupledSystem(
-        [Block(name, model, [BlockTerm(model)])],
-        [LinearConstraint(rows, None, "clamp", kind="dirichlet")],
-    )
+        geometry = "3d" if case == "taylor-3d" else "axisymmetric"
+        r = run_taylor_bar(t_end=t_end, geometry=geometry)
+        return r, r.n_elements
+    from arlequin.demos.ball_impact import run_ball_impact
+
+    ratio = 1 if case == "ball-1" else None
+    try:
+        r = run_ball_impact(regime="plastic", t_end=t_end, coarse_step_ratio=ratio)
+    except ValueError as exc:
+        # a window that ends in contact: the demo refuses its summary, the steps are timed
+        if "still in contact" not in str(exc):
+            raise
+        return None, None
+    return r, r.n_elements
 
 
-def _time_steps(integ: CentralDifference, steps: int, repeats: int = 5) -> tuple[float, float]:
-    """Best (over repeats) mean step time, and the mean constraint time of that same repeat."""
-    best, best_c = np.inf, np.nan
-    for _ in range(repeats):
-        c0 = getattr(integ, "constraint_time", 0.0)
+def _ball_elements() -> int:
+    """The plastic ball impact's elements (its bodies as ``run_ball_impact`` builds them)."""
+    from arlequin.demos.ball_impact import BallImpactConfig
+    from arlequin.demos.ball_impact.setup import ImpactBodies
+
+    i = BallImpactConfig(regime="plastic").resolved
+    bodies = ImpactBodies(i.model, i.sizes, i.radius, i.block_radius, i.block_height,
+                          i.ball_material, i.block_material, rigid_wall=i.rigid_wall,
+                          friction=i.friction)  # fmt: skip
+    return bodies.n_elements
+
+
+def measure(case: str, t_end: float | None = None, repeat: int = 1, clock: str = "wall") -> dict:
+    """The timed split of ``case`` (see the module docstring) as a JSON-ready dict."""
+    from arlequin.solvers.timing import StepTimer
+
+    if case not in CASES:
+        raise ValueError(f"case must be one of {CASES}, got {case!r}")
+    if repeat < 1:
+        raise ValueError(f"repeat must be at least 1, got {repeat}")
+    t_end = DEFAULT_T_END[case] if t_end is None else float(t_end)
+    if not t_end > 0.0:
+        raise ValueError(f"t_end must be positive (s), got {t_end}")
+    _run(case, min(t_end, 0.5e-6))  # compile or load the kernels
+    best, rounds = None, []
+    for _ in range(repeat):
         t0 = time.perf_counter()
-        for _ in range(steps):
-            integ.step()
-        t = (time.perf_counter() - t0) / steps
-        if t < best:
-            best, best_c = t, (getattr(integ, "constraint_time", 0.0) - c0) / steps
-    return best, best_c
-
-
-def run(h: float = 1.0 / 64.0, steps: int = 300, gluing_elements: int = 4) -> dict:
-    t0 = time.perf_counter()
-    cant = build_cantilever(ratio=0.5, h=h, gluing_width=gluing_elements * h, initial_state=False)
-    system = cant.problem.system()
-    build_s = time.perf_counter() - t0
-    rng = np.random.default_rng(0)
-    coupled = CentralDifference(system, u0=None, v0=1e-3 * rng.standard_normal(system.n_dofs))
-    dt = coupled.dt
-    coarse_model = cant.problem.model("coarse")
-    fine_model = cant.problem.model("patch0")
-    fine = CentralDifference(
-        _alone(fine_model, "fine"), dt=dt, v0=1e-3 * rng.standard_normal(fine_model.n_dofs)
-    )
-    coarse = CentralDifference(
-        _alone(coarse_model, "coarse"), dt=dt, v0=1e-3 * rng.standard_normal(coarse_model.n_dofs)
-    )
-    # warm-up
-    for integ in (coupled, fine, coarse):
-        for _ in range(10):
-            integ.step()
-    t_coupled, overhead_total = _time_steps(coupled, steps)
-    t_fine, _ = _time_steps(fine, steps)
-    t_coarse, _ = _time_steps(coarse, steps)
-    coupling_rows = sum(c.n_rows for c in system.constraints if c.kind == "coupling")
+        with StepTimer(clock=clock) as timer:
+            _, elements = _run(case, t_end)
+        wall = time.perf_counter() - t0
+        rounds.append(timer.step)
+        if best is None or timer.step < best[0].step:
+            best = (timer, wall, elements)
+    timer, wall, elements = best
+    if elements is None:  # a ball window ending in contact: no summary
+        elements = _ball_elements()
+    rep = timer.report()
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     return {
-        "n_coarse_elements": cant.n_coarse_elements,
-        "n_fine_elements": cant.n_fine_elements,
-        "n_dofs": system.n_dofs,
-        "n_coupling_rows": coupling_rows,
-        "gluing_band_coarse_elements": gluing_elements,
-        "overlap_method": cant.problem.couplings[0].overlap.method,
-        "setup_seconds": build_s,
-        "dt": dt,
-        "steps_timed": steps,
-        "coupled_step_seconds": t_coupled,
-        "fine_alone_step_seconds": t_fine,
-        "coarse_alone_step_seconds": t_coarse,
-        "coupling_overhead_seconds": overhead_total,
-        "coupling_overhead_fraction": overhead_total / t_coupled,
-        "coupled_over_sum_of_models": t_coupled / (t_fine + t_coarse),
-        "target_overhead_fraction": 0.30,
+        "case": case,
+        "clock": clock,
+        "t_end_s": t_end,
+        "elements": elements,
+        "steps": rep["steps"],
+        "steps_per_second": round(rep["steps_per_second"], 2),
+        "overhead_share": round(rep["overhead_share"], 4),
+        "step_seconds": round(rep["step_seconds"], 4),
+        "kernel_seconds": round(rep["kernel_seconds"], 4),
+        "linear_algebra_seconds": round(rep["linear_algebra_seconds"], 4),
+        "other_seconds": round(rep["other_seconds"], 4),
+        "other_ms_per_step": round(1e3 * rep["other_seconds"] / max(rep["steps"], 1), 4),
+        "first_step_seconds": round(rep["first_step_seconds"], 4),
+        "wall_time_s": round(wall, 3),
+        "step_seconds_all": [round(x, 4) for x in rounds],
+        "peak_memory_mb": round(peak, 1),
+        "threads": _threads.settings(),
     }
 
 
-def main(argv=None) -> int:
-    p = argparse.ArgumentParser(
-        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
-    )
-    p.add_argument("--h", type=float, default=1.0 / 64.0, help="coarse element size (m)")
-    p.add_argument("--steps", type=int, default=300)
-    p.add_argument(
-        "--gluing-elements", type=int, default=4, help="gluing band width in coarse elements"
-    )
-    p.add_argument("--json", default=None)
-    args = p.parse_args(argv)
-    logging.basicConfig(level=logging.WARNING)
-    out = run(args.h, args.steps, args.gluing_elements)
-    text = json.dumps(out, indent=2)
-    if args.json:
-        with open(args.json, "w", encoding="utf-8") as fh:
-            fh.write(text)
-    print(text)
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--case", choices=CASES, default="taylor-2d")
+    parser.add_argument("--repeat", type=int, default=1,
+                        help="runs; the one with the shortest step time is reported")  # fmt: skip
+    parser.add_argument("--t-end", type=float, default=None, help="simulated time (s)")
+    parser.add_argument("--clock", choices=["wall", "thread"], default="wall",
+                        help="the timers' clock: wall time, or the main thread's CPU time "
+                             "(other jobs' load left out; kernels' other threads too)")  # fmt: skip
+    args = parser.parse_args(argv)
+    print(json.dumps(measure(args.case, args.t_end, args.repeat, args.clock), indent=2))
     return 0
 
 

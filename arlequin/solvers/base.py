@@ -33,6 +33,7 @@ from ..problem.system import CoupledSystem, LinearConstraint
 from .controllers import StepController, as_controller, check_step
 from .operators import SystemOperators, as_system, as_vector
 from .rows import EqualityRows, consistent_initial_state, scatter_active, stack_active
+from .timing import SWITCH
 
 __all__ = ["STATUSES", "Integrator", "IntegratorSnapshot"]
 
@@ -320,6 +321,8 @@ class Integrator:
             self.set_step_size(dt)
         t_next = self.t + self.dt
         t_old, dt_step, err = self.t, self.dt, self._t_err
+        timer = SWITCH.timer
+        tic = timer.clock() if timer is not None else 0.0
         try:
             self._step_impl()
         except StateError as err:
@@ -333,6 +336,8 @@ class Integrator:
         self._t_err = 0.0 if landed else (self.t - t_old) - (dt_step - err)
         if self.t_stops.size and self.t >= self.t_stops[-1]:
             self.status = "finished"
+        if timer is not None:
+            timer.end_step(timer.clock() - tic)
 
     def _check_finite(self, t_new: float, *arrays: np.ndarray, step: int | None = None) -> None:
         """Raise SimulationError if any array has a NaN or would overflow its energy (``step``:

@@ -50,8 +50,9 @@ from .damping import RayleighDamping
 from .impulses import ImpulseSolver
 from .registry import register
 from .row_basis import ImpulseBasis
-from .rows import EqualityRows, transposed, unilateral_block_powers
+from .rows import EqualityRows, transposed_times, unilateral_block_powers
 from .stability import DEFAULT_SAFETY, StableStep, check_time_step, stable_time_step
+from .timing import SWITCH
 
 __all__ = ["DEFAULT_SAFETY", "CentralDifference"]
 
@@ -244,6 +245,8 @@ class CentralDifference(Integrator):
         u, t = self.u, self.t
         solver = self._impulse_solver()
         t_next = self._end_time()
+        timer = SWITCH.timer
+        tic = timer.clock() if timer is not None else 0.0
         r_e = self._rhs_equality(v_star, u, t_next) if rows.m else np.zeros(0)
         minv = self.ops.inv_mass
         if not self.unilateral:
@@ -252,7 +255,11 @@ class CentralDifference(Integrator):
             if rows.m:
                 v_new[rows.cols] -= self._minv_cols * (rows.matrix_cols_t @ lam_e)
             self.status_iterations = 0
+            if timer is not None:
+                timer.linear_algebra += timer.clock() - tic
             return lam_e, self._no_lam, [], self._no_rows, v_new, []
+        if timer is not None:
+            timer.linear_algebra += timer.clock() - tic
         trials = self._begin_unilateral(t, dt, u, v_star)
         converged = False
         it = 0
@@ -268,6 +275,7 @@ class CentralDifference(Integrator):
                 v_star = v_free + dt_bar * minv * f_app
                 r_e = self._rhs_equality(v_star, u, t_next) if rows.m else r_e0
             # velocity-level rows (contact) target rhs_a itself: no product with u for them
+            tic = timer.clock() if timer is not None else 0.0
             w_a = np.where(disp, (rhs_a - g_a @ u) / dt, rhs_a) if disp.any() else rhs_a
             r_a = g_a @ v_star - w_a
             lam_e, lam_a = solver.solve(r_e, g_a, r_a)
@@ -275,7 +283,9 @@ class CentralDifference(Integrator):
             if rows.m:
                 v_new[rows.cols] -= self._minv_cols * (rows.matrix_cols_t @ lam_e)
             if g_a.shape[0]:
-                v_new -= minv * (transposed(g_a) @ lam_a)
+                v_new -= minv * transposed_times(g_a, lam_a)
+            if timer is not None:
+                timer.linear_algebra += timer.clock() - tic
             fulls = self._full_multipliers(lam_a / dt_bar, idx)
             if f_app is not None:
                 fulls = [f if a is None else f + a for f, a in zip(fulls, applied)]

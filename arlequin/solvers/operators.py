@@ -32,6 +32,7 @@ from ..contract import (
     is_linear,
 )
 from ..problem.system import Block, BlockTerm, CoupledSystem
+from .timing import SWITCH
 
 __all__ = ["TANGENTS", "SystemOperators", "as_system", "as_vector"]
 
@@ -203,6 +204,8 @@ class SystemOperators:
         tangent : sparse (n, n) or None
             Tangent (N/m) when ``tangent`` is True (see the ``tangent`` parameter of the class).
         """
+        timer = SWITCH.timer
+        tic = timer.clock() if timer is not None else 0.0
         if blocks is not None:
             if tangent:
                 raise ValueError("internal_force: a tangent is assembled for every block")
@@ -214,6 +217,8 @@ class SystemOperators:
             # the assembled (linear) part; nothing to multiply when every term is nonlinear
             f = self.stiffness @ u if self.stiffness.nnz else np.zeros(u.shape)
             terms = self._nonlinear_terms
+        if timer is not None:
+            timer.linear_algebra += timer.clock() - tic
         trial = {name: list(s) for name, s in states.items()}
         if not terms:
             return f, trial, (self.stiffness if tangent else None)
@@ -224,10 +229,13 @@ class SystemOperators:
             b = self.blocks[bi]
             ut = self._term_u(b, term, u)
             state = states[b.name][ti]
+            tic = timer.clock() if timer is not None else 0.0
             if getattr(term.model, "uses_time_step", False):
                 ft, new_state = term.model.internal_force(ut, state, term.weight, dt=dt)
             else:
                 ft, new_state = term.model.internal_force(ut, state, term.weight)
+            if timer is not None:
+                timer.kernel += timer.clock() - tic
             trial[b.name][ti] = new_state
             p = term.transfer
             f[b.dofs] += term.sign * (ft if p is None else p.T @ ft)
@@ -271,8 +279,16 @@ class SystemOperators:
     # ------------------------------------------------------------------ per-block reductions
     def block_dots(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
         """Per-block dot products Σ_{j∈b} x_j y_j, shape (n_blocks,)."""
-        prod = x * y
-        return np.add.reduceat(prod, self.offsets[:-1]) if self.n else np.zeros(len(self.blocks))
+        if not self.n:
+            return np.zeros(len(self.blocks))
+        # the products in a buffer kept between calls (several a step): no new n-array each
+        if np.shape(x) != np.shape(y):
+            return np.add.reduceat(x * y, self.offsets[:-1])
+        buf = self.__dict__.get("_dots_buffer")
+        if buf is None or buf.shape != np.shape(x) or np.result_type(x, y) != buf.dtype:
+            buf = self.__dict__["_dots_buffer"] = np.empty(np.shape(x), np.result_type(x, y))
+        np.multiply(x, y, out=buf)
+        return np.add.reduceat(buf, self.offsets[:-1])
 
     def mass_times(self, x: np.ndarray) -> np.ndarray:
         """M x (N·s²/m × x)."""

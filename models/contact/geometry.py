@@ -192,6 +192,9 @@ class ContactPair:
 
     slave: ContactSurface
     n_dofs: int
+    #: The global dofs the geometry depends on (sorted), or None (a pair that does not say):
+    #: a constraint reuses the last geometry when u is unchanged on them.
+    geometry_dofs: np.ndarray | None = None
 
     @property
     def n_points(self) -> int:
@@ -233,6 +236,7 @@ class RigidContactPair(ContactPair):
         self._r = np.repeat(np.arange(m), d)
         self._c = slave.node_dofs(slave.nodes).T.ravel()
         self._rows_cache: tuple[np.ndarray, sp.csr_matrix] | None = None
+        self.geometry_dofs = np.unique(self._c)
 
     def geometry(self, u: np.ndarray) -> ContactGeometry:
         x = self.slave.positions(u)
@@ -301,6 +305,7 @@ class DeformableContactPair(ContactPair):
         self._r_m = np.repeat(np.arange(m), nv * d)
         self._pattern: tuple | None = None  # the rows' pattern for the last facets (geometry)
         self._orient_f = np.ascontiguousarray(self._orient, dtype=float)
+        self.geometry_dofs = np.unique(np.concatenate([self._c_s, self._tri_dofs.ravel()]))
 
     def _project(self, xs: np.ndarray, u: np.ndarray):
         """Closest master facet of each slave point: (facet, shape values (m, n_v), x_m, normal)."""

@@ -208,9 +208,15 @@ class _ContactConstraint:
         return self.pair.geometry(u)
 
     def _geometry_from(self, state: ContactState, u: np.ndarray) -> ContactGeometry:
-        if state.u_geometry is u or np.array_equal(state.u_geometry, u):
+        last = state.u_geometry
+        if last is u:
             return state.geometry
-        return self.geometry(u)
+        # the geometry depends on the pair's dofs alone: compared there (a few hundred values,
+        # not the whole system's at every step)
+        dofs = getattr(self.pair, "geometry_dofs", None)
+        same = np.array_equal(last, u) if dofs is None or last.shape != u.shape else \
+            np.array_equal(last[dofs], u[dofs])  # fmt: skip
+        return state.geometry if same else self.geometry(u)
 
     def gaps(self, u: np.ndarray) -> np.ndarray:
         """d_n (m) at the collocation points for displacement u, shape (m,)."""

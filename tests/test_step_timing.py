@@ -1,0 +1,90 @@
+"""The explicit step's optional timers and the per-step shortcuts of issue 30.
+
+The shortcuts must give the same numbers bit for bit as the code they replace (their
+references are computed here on the same data); the timers must only count.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from arlequin.solvers.rows import transposed, transposed_times
+from arlequin.solvers.timing import SWITCH, StepTimer
+
+
+def _random_rows(rng, m: int, n: int, duplicates: bool) -> sp.csr_matrix:
+    nnz = int(rng.integers(1, 4 * m + 2))
+    rows, cols = rng.integers(0, m, nnz), rng.integers(0, n, nnz)
+    data = rng.standard_normal(nnz) * 10.0 ** rng.integers(-6, 7, nnz)
+    if not duplicates:
+        return sp.csr_matrix((data, (rows, cols)), shape=(m, n))
+    # a CSR with duplicate, unsorted entries (rows grouped, columns as drawn)
+    order = np.argsort(rows, kind="stable")
+    indptr = np.concatenate([[0], np.cumsum(np.bincount(rows, minlength=m))])
+    return sp.csr_matrix((data[order], cols[order], indptr), shape=(m, n))
+
+
+@pytest.mark.parametrize("duplicates", [False, True])
+def test_transposed_times_is_the_transposed_product_bit_for_bit(duplicates):
+    # reference: the CSR product with the cached transpose it replaces in the explicit step
+    rng = np.random.default_rng(30)
+    for _ in range(100):
+        m, n = int(rng.integers(1, 30)), int(rng.integers(1, 200))
+        g = _random_rows(rng, m, n, duplicates)
+        lam = rng.standard_normal(m) * 1e4
+        assert np.array_equal(transposed_times(g, lam), transposed(g) @ lam)
+
+
+def test_timer_is_off_by_default_and_restored_after_its_context():
+    assert SWITCH.timer is None
+    with StepTimer() as outer:
+        assert SWITCH.timer is outer
+        with StepTimer() as inner:
+            assert SWITCH.timer is inner
+        assert SWITCH.timer is outer
+    assert SWITCH.timer is None
+
+
+@pytest.mark.parametrize("clock", ["wall", "thread"])
+def test_timer_splits_the_steps_of_an_explicit_run(clock):
+    from arlequin.demos.two_bars import run_two_bars
+
+    plain = run_two_bars(integrator="explicit")
+    with StepTimer(clock=clock) as timer:
+        timed = run_two_bars(integrator="explicit")
+    rep = timer.report()
+    # the first step apart; the others all counted (the run's steps from its recorded times)
+    assert rep["steps"] == len(timed.t) - 2
+    assert rep["first_step_seconds"] >= 0.0
+    assert rep["linear_algebra_seconds"] > 0.0
+    assert rep["kernel_seconds"] == 0.0  # linear models: no model's internal force call
+    assert rep["other_seconds"] == pytest.approx(
+        rep["step_seconds"] - rep["linear_algebra_seconds"]
+    )
+    assert 0.0 <= rep["overhead_share"] <= 1.0
+    # the timers change nothing in the run
+    assert np.array_equal(plain.contact_pressure, timed.contact_pressure)
+    assert np.array_equal(plain.total_energy, timed.total_energy)
+
+
+def test_block_dots_with_its_buffer_equal_the_plain_products():
+    from arlequin.demos.two_bars import TwoBarsConfig
+    from arlequin.demos.two_bars.setup import TwoBarsSetup
+    from arlequin.problem.system import Block, BlockTerm, CoupledSystem
+    from arlequin.solvers.operators import SystemOperators
+
+    bodies = TwoBarsSetup(TwoBarsConfig()).impact("levelset").bodies
+    system = CoupledSystem([Block(f"bar{i}", b, [BlockTerm(b)]) for i, b in enumerate(bodies)])
+    ops = SystemOperators(system, lumped=True)
+    rng = np.random.default_rng(1)
+    for _ in range(3):
+        x, y = rng.standard_normal(ops.n), rng.standard_normal(ops.n)
+        # reference: the products summed per block by reduceat, as before the buffer
+        assert np.array_equal(ops.block_dots(x, y), np.add.reduceat(x * y, ops.offsets[:-1]))
+
+
+def test_timer_refuses_an_unknown_clock():
+    with pytest.raises(ValueError, match="clock"):
+        StepTimer(clock="cpu")
