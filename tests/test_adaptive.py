@@ -127,7 +127,8 @@ def test_a_threshold_outside_zero_one_is_refused(beta):
         AdaptivePatch(threshold=beta)
 
 
-BAD = [("buffer", -1), ("every", 0), ("max_fraction", 0.0), ("max_fraction", 1.5)]
+BAD = [("buffer", -1), ("every", 0), ("max_fraction", 0.0), ("max_fraction", 1.5),
+       ("band_weight", -0.1), ("band_weight", 1.0)]  # fmt: skip
 
 
 @pytest.mark.parametrize(("option", "value"), BAD)
