@@ -179,6 +179,8 @@ def plate_case(repeat: int, memory: bool) -> dict:
         # patch's gluing band; and the coarse cells over a plastic fine cell plus one ring
         "patch_over_plastic_zone_and_band": a["patch_fraction"]
         / (a["plastic_fraction"] + a["band_fraction"]),
+        "fixed_patch_over_plastic_zone_and_band": out["fixed"]["patch_fraction"]
+        / (out["fixed"]["plastic_fraction"] + out["fixed"]["band_fraction"]),
         "patch_over_plastic_cover": a["patch_fraction"] / a["plastic_cover_fraction"],
         "fixed_patch_over_plastic_cover": out["fixed"]["patch_fraction"]
         / out["fixed"]["plastic_cover_fraction"],
