@@ -127,7 +127,8 @@ def test_a_threshold_outside_zero_one_is_refused(beta):
         AdaptivePatch(threshold=beta)
 
 
-BAD = [("buffer", -1), ("every", 0), ("max_fraction", 0.0), ("max_fraction", 1.5)]
+BAD = [("buffer", -1), ("every", 0), ("max_fraction", 0.0), ("max_fraction", 1.5),
+       ("band_weight", -0.1), ("band_weight", 1.0)]  # fmt: skip
 
 
 @pytest.mark.parametrize(("option", "value"), BAD)
@@ -277,3 +278,56 @@ def test_adaptive_sphere_matches_the_fixed_patch_at_the_default_resolution():
     assert all(abs(g["energy_jump"]) < 1e-2 for g in a.adaptations)  # measured <= 4.3e-3
     assert a.patch_fraction == pytest.approx(f.patch_fraction)
     assert min(times[True]) <= 1.3 * min(times[False]), times
+
+
+@pytest.mark.parametrize(("band_weight", "counted"), [(0.0, True), (0.5, False)])
+def test_band_weight_disregards_plastic_points_of_the_bands_outer_part(band_weight, counted):
+    """Plastic strain put at the patch's quadrature points where α_f < 1/2 (the band's outer
+    half, by construction of the state, not by a run): counted by default (the step rejected,
+    the cells beyond flagged), disregarded with ``band_weight=0.5`` (no flag, no rejection);
+    the same strain where α_f ≥ 1/2 in the band is counted by both."""
+    from types import SimpleNamespace
+
+    from arlequin.adapt import AdaptView
+
+    problem, mesh = _problem(2, ((1.4, 0.0), (2.6, 1.2)))
+    adapt = AdaptivePatch(band_weight=band_weight)
+    adapt.bind(problem)
+    pc = adapt.problem.couplings[0]
+    alpha = np.asarray(pc.alpha_fine)
+    band = np.zeros(pc.fine_model.mesh.nelements, dtype=bool)
+    band[pc.fine_gluing_cells] = True
+    outside = np.ones(mesh.nelements, dtype=bool)
+    outside[adapt.cells] = False
+
+    def flags(where):
+        state = SimpleNamespace(eqps=np.where(where, 1e-4, 0.0))
+        view = AdaptView(1, 1.0, adapt.problem, None, None, state, adapt.cells,
+                         np.zeros(mesh.nelements), 1e15)  # fmt: skip
+        return adapt._band_flags(view, outside)
+
+    outer = band[:, None] & (alpha < 0.5)
+    assert outer.any() and (band[:, None] & (alpha >= 0.5)).any()
+    near, in_band = flags(outer)
+    assert in_band == counted and near.any() == counted
+    near, in_band = flags(band[:, None] & (alpha >= 0.5))
+    assert in_band and near.any()
+
+
+def test_no_growth_after_the_last_step():
+    """An indicator flagging one more coarse cell after every step: the patch grows after
+    each step but the last (a growth prepares the next step; none follows the last), and the
+    final patch is the one the last state was computed on."""
+    problem, mesh = _problem(2, ((1.4, 0.0), (2.6, 1.2)))
+    centres = mesh.p[:, mesh.t].mean(axis=1)
+
+    def one_more(view):
+        flags = np.zeros(mesh.nelements, dtype=bool)
+        out = np.setdiff1d(np.arange(mesh.nelements), view.patch_cells)
+        flags[out[np.argmin(np.hypot(centres[0, out] - 2.0, centres[1, out] - 0.5))]] = True
+        return flags
+
+    adapt = AdaptivePatch(indicator=one_more, buffer=0)
+    result = solve_quasi_static(problem, steps=3, adapt=adapt)
+    assert [r.step for r in result.adaptations] == [1, 2]
+    assert result.problem.patches[0].model.mesh.nelements == 4 * adapt.cells.size

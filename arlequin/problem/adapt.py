@@ -256,6 +256,13 @@ class AdaptivePatch:
         cell) completed to a shape the problem keeps (the pressure vessel: whole rings, so that
         the gluing band stays a ring: bands with corners do not reproduce a uniform stress with
         a coarse mediator and let the fine modes there yield spuriously). It may only add cells.
+    band_weight : float
+        In [0, 1): plastic strain at the patch's quadrature points where its weight α_f is
+        below this is disregarded by the indicator and by ``reject_band_plasticity`` (default
+        0: every plastic point counts). Near the band's outer edge α_f → ε: the fine model's
+        stress there, the multipliers' forces over a vanishing stiffness, is not the coupled
+        model's (α_c σ_c + α_f σ_f), and yields where the coarse stress is 0.85 σ_y (the plate
+        with a hole).
     """
 
     def __init__(
@@ -273,6 +280,7 @@ class AdaptivePatch:
         reject_band_plasticity: bool = True,
         closure: Callable[[np.ndarray], np.ndarray] | None = None,
         interval: float | None = None,
+        band_weight: float = 0.0,
     ) -> None:
         if not (isinstance(threshold, (int, float)) and 0.0 < threshold <= 1.0):
             raise ValueError(f"threshold β must lie in (0, 1], got threshold={threshold!r}")
@@ -287,6 +295,8 @@ class AdaptivePatch:
         self.interval = None if interval is None else float(interval)
         if not (0.0 < max_fraction <= 1.0):
             raise ValueError(f"max_fraction must lie in (0, 1], got max_fraction={max_fraction}")
+        if not (isinstance(band_weight, (int, float)) and 0.0 <= band_weight < 1.0):
+            raise ValueError(f"band_weight must lie in [0, 1), got band_weight={band_weight!r}")
         if levels is not None and (int(levels) != levels or levels < 0):
             raise ValueError(f"levels must be a non-negative integer, got levels={levels}")
         if indicator is not None and not callable(indicator):
@@ -297,7 +307,7 @@ class AdaptivePatch:
         self.index, self.reject_band_plasticity = int(patch), bool(reject_band_plasticity)
         if closure is not None and not callable(closure):
             raise ValueError(f"closure must be callable, got {type(closure).__name__}")
-        self.closure = closure
+        self.closure, self.band_weight = closure, float(band_weight)
         self.records: list[Adaptation] = []
         self.max_coarse_yield_ratio = 0.0
         self.problem: ArlequinProblem | None = None
@@ -433,7 +443,10 @@ class AdaptivePatch:
         fmesh = model.mesh
         band = np.zeros(fmesh.nelements, dtype=bool)
         band[pc.fine_gluing_cells] = True
-        plastic = ep.max(axis=1) > 0.0
+        plastic_points = ep > 0.0
+        if self.band_weight > 0.0:  # the band's outer part, where α_f σ_f is not σ_f
+            plastic_points &= np.asarray(pc.alpha_fine) >= self.band_weight
+        plastic = plastic_points.any(axis=1)
         near = cell_rings(fmesh, band, self.band_cells) & plastic
         if not near.any():
             return np.zeros(outside.size, dtype=bool), False

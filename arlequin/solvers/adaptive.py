@@ -1,16 +1,18 @@
 """The quasi-static load stepping of an adaptive patch (``solve_quasi_static(..., adapt=)``).
 
 After each converged step the adaptation object (:class:`arlequin.problem.adapt.AdaptivePatch`,
-called duck-typed: the solvers never import the problem's set-up) is asked
-``assess(solver, step)``. ``None``: the step stands. A growth: the new problem and the committed
-fields moved onto it come from ``adapt.grow(growth, u, states, step, λ)``; the solver goes on
-with them (``replace_system``) and re-solves the multipliers by Newton at the same load
-(``resolve``). A *rejected* step (the coarse model yields outside the patch) is first undone
-(``restore``): the patch grows from the committed state and the step is computed again. Each
-growth records the relative jump of the total stored energy across it and the iterations of the
-re-solve, and the time of its parts (:class:`~arlequin.problem.adapt.Adaptation`: the rebuild and
-the transfer, the solver's new operators, the re-solve, the rejected step's); listeners with an
-``on_adapt(solver, adapt)`` member (the results writers) hear of it.
+called duck-typed: the solvers never import the problem's set-up) is asked ``assess(solver,
+step)``. ``None``: the step stands. A growth: the new problem and the committed fields moved
+onto it come from ``adapt.grow(growth, u, states, step, λ)``; the solver goes on with them
+(``replace_system``) and re-solves the multipliers by Newton at the same load (``resolve``); one
+asked after the last step is not made (it would serve the next step, and there is none: the last
+state stands as accepted). A *rejected* step (the coarse model yields outside the patch) is
+first undone (``restore``): the patch grows from the committed state and the step is computed
+again. Each growth records the relative jump of the total stored energy across it and the
+iterations of the re-solve, and the time of its parts
+(:class:`~arlequin.problem.adapt.Adaptation`: the rebuild and the transfer, the solver's new
+operators, the re-solve, the rejected step's); listeners with an ``on_adapt(solver, adapt)``
+member (the results writers) hear of it.
 """
 
 from __future__ import annotations
@@ -146,7 +148,8 @@ def run_adaptive(
                 continue
             for listener in on_step:
                 listener(solver)
-            if growth is not None:
+            # a growth for the next step: none after the last (its state was accepted)
+            if growth is not None and solver.status == "running":
                 _grow(solver, adapt, growth, step, on_step)
         except SimulationError as err:
             err.result = _finish(solver, adapt, str(err))

@@ -24,8 +24,9 @@ SuperLU factorisation of its Newton systems (the coarse plate, 880 dofs for the 
 is not condensed: forcing it changes nothing measurable).
 
 ``adaptive``: the patch starts from the coarse ring on the hole and grows where the plastic
-zone nears its gluing band or the coarse stress reaches β σy (default β 0.9), closed over
-re-entrant corners (:func:`.setup.fill_corners`); see ``docs/plate_with_hole.md``.
+zone nears its gluing band or the coarse stress reaches β σy (default β 0.9), the plastic
+points of the band's outer half (α_f < 1/2) disregarded, each growth closed over one-cell
+slots and notches (:func:`.setup.fill_notches`); see ``docs/plate_with_hole.md``.
 
 Outputs (``out``): results.json (inputs and results with units), ``newton.csv`` (per step:
 load factor, Newton iterations, residuals, cuts), the field series of each block

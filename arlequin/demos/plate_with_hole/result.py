@@ -29,6 +29,7 @@ UNITS = {
     "first_yield_load": "Pa",
     "max_coarse_yield_ratio": "1",
     "plastic_cover_fraction": "1",
+    "band_fraction": "1",
 }
 
 
@@ -73,6 +74,11 @@ class PlateWithHoleResult(JsonResult):
         ``gluing_rings`` layers around them (:func:`~.run.plastic_cover_fraction`; None for
         mono and graded). The adaptive patch's ``patch_fraction`` over it measures how tight
         the patch is.
+    band_fraction : float or None
+        The final patch's gluing band's share of the plate's area (its fine cells within
+        ``gluing_rings`` coarse cells of the patch's interior boundary; None for mono and
+        graded). Criterion 4 of issue 31 (the adaptive patch at most 1.5 times the plastic
+        zone and its band) reads ``patch_fraction ≤ 1.5 (plastic_area / plate + band_fraction)``.
     """
 
     history: dict[str, list[Any]]
@@ -86,6 +92,7 @@ class PlateWithHoleResult(JsonResult):
     adaptations: list[dict[str, Any]] = field(default_factory=list)
     max_coarse_yield_ratio: float | None = None
     plastic_cover_fraction: float | None = None
+    band_fraction: float | None = None
 
     json_exclude = ("config",)
 

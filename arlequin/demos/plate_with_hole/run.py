@@ -61,6 +61,15 @@ def plastic_cover_fraction(setup: PlateSetup, eqps: np.ndarray, rings: int) -> f
     return cells / area(setup.coarse)
 
 
+def band_fraction(setup: PlateSetup) -> float | None:
+    """The share of the plate's area of the patch's gluing band (its fine cells' area; None
+    without a coarse model over a patch)."""
+    if setup.plastic_block == "coarse":
+        return None
+    cells = setup.problem.couplings[0].fine_gluing_cells
+    return area(setup.plastic_model.mesh.restrict(cells)) / area(setup.coarse)
+
+
 class _Recorder:
     """The history of a run, one entry per converged state (an ``on_step`` listener)."""
 
@@ -207,6 +216,7 @@ def run(config: PlateWithHoleConfig, out: str | None = None,
         plastic_cover_fraction=plastic_cover_fraction(
             setup, solver.states[setup.plastic_block][setup.plastic_term].eqps, config.gluing_rings
         ),
+        band_fraction=band_fraction(setup),
     )
     if folder is not None:
         folder.add_results(result.to_json(), UNITS)
