@@ -7,10 +7,10 @@ Cases (``--case``), in one process (shortest of ``--repeat`` rounds):
 * ``sphere-2d`` (default): the pressure sphere at 300 MPa in 10 steps, 2D axisymmetric at the
   demo's defaults: ``arlequin``, ``arlequin`` with ``condense=False`` and ``mono`` with SuperLU,
   and ``arlequin`` and ``mono`` with each other linear solver of ``--linear-solvers``;
-* ``sphere-3d``: the eighth of the sphere on hexahedra, model ``arlequin`` (the coarse shell and
-  a J2 patch to 185 mm; ``--dim3-coarse`` and ``--dim3-fine`` sizes: 153,531 dofs at the
-  defaults), loaded to ``--pressure-3d`` in ``--steps-3d`` steps (the last two plastic at the
-  defaults), with each solver of ``--linear-solvers``;
+* ``sphere-3d``: the eighth of the sphere on hexahedra, model ``arlequin`` (the coarse shell
+  and a J2 patch to 183 mm; ``--dim3-coarse`` and ``--dim3-fine`` sizes), loaded to
+  ``--pressure-3d`` in ``--steps-3d`` steps (the last two plastic at the defaults), with each
+  solver of ``--linear-solvers``;
 * ``all``: both.
 
 Each run's time is split by the quasi-static solver's own timers
@@ -33,7 +33,7 @@ evaluations over ``constitutive_and_tangent_s``: internal forces included). Peak
 largest resident set sampled during each run (every 50 ms) and the process's peak.
 
     PYTHONPATH=. python benchmarks/quasi_static.py [--case {sphere-2d,sphere-3d,all}]
-        [--repeat 2] [--linear-solvers superlu,pardiso] [--dim3-fine 0.0041667]
+        [--repeat 2] [--linear-solvers superlu,pardiso] [--dim3-fine 0.0045455]
 
 Prints JSON.
 """
@@ -191,8 +191,8 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=1, help="rounds; each case's shortest")
     parser.add_argument("--linear-solvers", default="superlu,pardiso" if pardiso_available()
                         else "superlu", help="comma-separated: superlu, pardiso")  # fmt: skip
-    parser.add_argument("--dim3-coarse", type=float, default=0.1 / 6, help="3D coarse size (m)")
-    parser.add_argument("--dim3-fine", type=float, default=0.1 / 24, help="3D fine size (m)")
+    parser.add_argument("--dim3-coarse", type=float, default=0.1 / 5.5, help="3D coarse size (m)")
+    parser.add_argument("--dim3-fine", type=float, default=0.1 / 22, help="3D fine size (m)")
     parser.add_argument("--pressure-3d", type=float, default=3e8, help="3D final pressure (Pa)")
     parser.add_argument("--steps-3d", type=int, default=3, help="3D load steps")
     args = parser.parse_args()

@@ -69,6 +69,9 @@ def test_pardiso_agrees_with_superlu_and_keeps_its_analysis():
     # new values on the same pattern (a new Newton tangent): no new symbolic analysis
     _check_against_dense(solver, _saddle_point(scale=3.0))
     assert (solver.analyses, solver.factorisations) == (1, 4)
+    solver.renew_analysis()  # as at each load step: the next factor analyses again
+    _check_against_dense(solver, _saddle_point(scale=2.0))
+    assert (solver.analyses, solver.factorisations) == (2, 6)
     assert resolve_linear_solver("auto") == "pardiso"
 
 

@@ -14,8 +14,12 @@ elimination tree) across the factorisations does only the numerical factorisatio
 ``"pardiso"``
     Intel MKL PARDISO through :mod:`pypardiso` (an optional dependency: ``pip install
     arlequin[pardiso]``), imported only when asked for: the analysis (phase 11: METIS nested
-    dissection, weighted matching and scaling) is done once per sparsity pattern, each
-    factorisation is phase 22, each solve phase 33 (with PARDISO's iterative refinement). The
+    dissection, weighted matching and scaling) is done for the first matrix of a sparsity
+    pattern, or after :meth:`SparseDirectSolver.renew_analysis`, each factorisation is phase 22,
+    each solve phase 33 (with PARDISO's iterative refinement). The matching and scaling depend
+    on the values of the analysed matrix: the quasi-static solver renews the analysis at the
+    start of each load step, so that its pivoting follows the tangent as the material yields,
+    and so that a run resumed at a step factorises exactly as the uninterrupted run did. The
     matrix type is real nonsymmetric (``mtype=11``, pypardiso's default): the saddle points are
     symmetric indefinite, for which the symmetric types would need the upper triangle only and
     Bunch-Kaufman pivoting; the nonsymmetric type with matching is the robust choice.
@@ -102,7 +106,7 @@ class SparseDirectSolver:
         ``"factorisation_s"`` and ``"solve_s"``: seconds spent so far (wall time).
     factorisations, analyses : int
         Numerical factorisations done, and symbolic analyses (PARDISO: one per sparsity
-        pattern; SuperLU: one per factorisation).
+        pattern or :meth:`renew_analysis`; SuperLU: one per factorisation).
 
     Notes
     -----
@@ -117,6 +121,11 @@ class SparseDirectSolver:
         self._generation = 0
         self._pardiso: Any = None
         self._pattern: tuple[np.ndarray, np.ndarray] | None = None
+
+    def renew_analysis(self) -> None:
+        """Make the next :meth:`factor` start with a symbolic analysis of its matrix (PARDISO;
+        SuperLU analyses every matrix)."""
+        self._pattern = None
 
     def factor(self, mat: sp.spmatrix) -> _Factor:
         """Factorise ``mat`` (n, n); returns an object whose ``solve(rhs)`` takes rhs of shape

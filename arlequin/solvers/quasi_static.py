@@ -26,7 +26,7 @@ capacity: the incremental stiffness had dropped, or the tangent became singular)
 once for the whole run (:mod:`arlequin.solvers.condensation`): each Newton iteration factors
 only the nonlinear blocks and the multipliers. The factorisations use a sparse direct solver
 (``linear_solver``: SuperLU, or PARDISO where pypardiso is installed, which keeps its symbolic
-analysis from one iteration to the next: :mod:`arlequin.solvers.direct`).
+analysis from one iteration of a load step to the next: :mod:`arlequin.solvers.direct`).
 
 Timings: the solver adds up, over its load steps (failed attempts included), the wall time of
 the models' internal forces, return maps and tangent assembly, of the factorisations, of the
@@ -173,7 +173,7 @@ class QuasiStaticSolver(AdaptableSolver):
         self.max_iterations, self.growth = int(max_iterations), float(growth)
         self.easy_iterations, self.line_search = int(easy_iterations), bool(line_search)
         self.max_backtracks = int(max_backtracks)
-        self.ops = SystemOperators(self.system, lumped=False)
+        self.ops = SystemOperators(self.system, lumped=False, with_mass=False)
         self.ops.check_tangents("the quasi-static solver")
         self.condense = bool(condense)
         self.linear_solver = linear_solver
@@ -229,6 +229,8 @@ class QuasiStaticSolver(AdaptableSolver):
         """Newton at load factor ``lam`` from the committed state; returns the converged
         (u, μ, trial states, residual history) or raises :class:`_StepFailed`."""
         fixed_values, _ = self.prescribed(lam)
+        # PARDISO's pivoting from this step's first tangent (a resumed run factorises alike)
+        self.saddle.direct.renew_analysis()
         u, mu = self._predictor(lam)
         u[self.saddle.fixed] = fixed_values
         history: list[float] = []
@@ -432,7 +434,7 @@ class QuasiStaticSolver(AdaptableSolver):
         onto it at the same load factor (blocks missing from ``states``: initial states); the
         multipliers are zero until :meth:`resolve`."""
         self.system = as_system(system)
-        self.ops = SystemOperators(self.system, lumped=False)
+        self.ops = SystemOperators(self.system, lumped=False, with_mass=False)
         self.ops.check_tangents("the quasi-static solver")
         timings = self.saddle.direct.timings
         self.saddle = SaddleSolver(self.system, self.ops, condense=self.condense,
