@@ -33,7 +33,7 @@ evaluations over ``constitutive_and_tangent_s``: internal forces included). Peak
 largest resident set sampled during each run (every 50 ms) and the process's peak.
 
     PYTHONPATH=. python benchmarks/quasi_static.py [--case {sphere-2d,sphere-3d,all}]
-        [--repeat 2] [--linear-solvers superlu,pardiso] [--dim3-fine 0.0045455]
+        [--repeat 2] [--linear-solvers superlu,pardiso] [--dim3-fine 0.0045]
 
 Prints JSON.
 """
@@ -191,8 +191,9 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=1, help="rounds; each case's shortest")
     parser.add_argument("--linear-solvers", default="superlu,pardiso" if pardiso_available()
                         else "superlu", help="comma-separated: superlu, pardiso")  # fmt: skip
-    parser.add_argument("--dim3-coarse", type=float, default=0.1 / 5.5, help="3D coarse size (m)")
-    parser.add_argument("--dim3-fine", type=float, default=0.1 / 22, help="3D fine size (m)")
+    # 6 shells of 6 x 6 x 3 cells, the patch 5 shells refined twice: 118k dofs
+    parser.add_argument("--dim3-coarse", type=float, default=0.018, help="3D coarse size (m)")
+    parser.add_argument("--dim3-fine", type=float, default=0.0045, help="3D fine size (m)")
     parser.add_argument("--pressure-3d", type=float, default=3e8, help="3D final pressure (Pa)")
     parser.add_argument("--steps-3d", type=int, default=3, help="3D load steps")
     args = parser.parse_args()

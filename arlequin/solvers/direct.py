@@ -24,9 +24,10 @@ elimination tree) across the factorisations does only the numerical factorisatio
     symmetric indefinite, for which the symmetric types would need the upper triangle only and
     Bunch-Kaufman pivoting; the nonsymmetric type with matching is the robust choice.
 ``"auto"``
-    ``"pardiso"`` where pypardiso is installed, else ``"superlu"`` (on the 3D sphere of the
-    quasi-static benchmark, 118k dofs, a PARDISO factorisation is ~17x faster than SuperLU's:
-    ``docs/quasi_static.md``).
+    ``"pardiso"`` where pypardiso is installed, else ``"superlu"``: on the 3D eighth of the
+    pressure sphere at 32,778 dofs (``benchmarks/quasi_static.py --case sphere-3d``), where the
+    factorisations are most of a Newton iteration, a PARDISO factorisation is 4.2x faster than
+    SuperLU's and the run 2.8x (``docs/quasi_static.md``, the cost).
 
 A singular matrix raises :class:`numpy.linalg.LinAlgError` with both backends: SuperLU's exact
 zero pivot, or for PARDISO (which perturbs tiny pivots instead of failing) a solution whose
