@@ -36,12 +36,11 @@ from contextlib import contextmanager
 
 import _threads  # before numba runs: OpenMP threads sleep between parallel regions
 import numpy as np
-import scipy.sparse.linalg as spla
 from _newton import contraction_summary, newton_record
 
 from arlequin.demos.plate_with_hole import run_plate_with_hole
 from arlequin.models import SmallStrainJ2
-from arlequin.solvers import condensation
+from arlequin.solvers import condensation, direct
 
 MODELS = ("mono", "arlequin", "graded")
 
@@ -73,12 +72,14 @@ def timed_run(model: str, levels: int, steps: int, repeat: int):
 
 @contextmanager
 def timed_split():
-    """Wall time spent in the J2 return and force, its tangent's assembly, SuperLU's
-    factorisation and the triangular solves, by wrapping those functions (restored after)."""
+    """Wall time spent in the J2 return and force, its tangent's assembly, the Newton systems'
+    factorisations and solves (:class:`arlequin.solvers.direct.SparseDirectSolver`, whichever
+    backend), by wrapping those functions (restored after)."""
     split = {"constitutive_update": 0.0, "tangent_assembly": 0.0, "factorisation": 0.0,
              "solves": 0.0}  # fmt: skip
     originals = [(SmallStrainJ2, "internal_force"), (SmallStrainJ2, "tangent"),
-                 (spla, "splu"), (condensation, "_factor_solve")]  # fmt: skip
+                 (direct.SparseDirectSolver, "factor"),
+                 (direct.SparseDirectSolver, "_solve")]  # fmt: skip
     saved = [getattr(owner, name) for owner, name in originals]
 
     def wrap(fn, key):
@@ -93,15 +94,13 @@ def timed_split():
 
     SmallStrainJ2.internal_force = wrap(saved[0], "constitutive_update")
     SmallStrainJ2.tangent = wrap(saved[1], "tangent_assembly")
-    spla.splu = wrap(saved[2], "factorisation")
-    condensation._factor_solve = wrap(saved[3], "solves")
+    direct.SparseDirectSolver.factor = wrap(saved[2], "factorisation")
+    direct.SparseDirectSolver._solve = wrap(saved[3], "solves")
     try:
         yield split
     finally:
         for (owner, name), fn in zip(originals, saved):
             setattr(owner, name, fn)
-        # the factorisation ran inside _factor_solve: the solves are the rest of it
-        split["solves"] -= split["factorisation"]
 
 
 def max_contraction(residuals) -> float:

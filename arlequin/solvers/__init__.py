@@ -23,7 +23,8 @@ One concept a module: ``operators`` (mass, forces, tangents), ``rows`` (constrai
 damping), ``controllers`` (step sizes), ``base`` (the :class:`Integrator` class), ``registry``,
 ``explicit``, ``subcycling``, ``implicit``, ``stability``, ``recorder``, ``result``, ``driver``
 (:func:`solve`), ``static``, ``quasi_static`` (load stepping with Newton,
-:func:`solve_quasi_static`), ``condensation`` (its Newton systems), ``loads``.
+:func:`solve_quasi_static`), ``condensation`` (its Newton systems), ``direct`` (their sparse
+direct solvers: SuperLU, or PARDISO where pypardiso is installed), ``loads``.
 """
 
 from ..contract import ConstraintError, SimulationError, UnilateralConstraint

@@ -23,17 +23,23 @@ path, ``condense=False``).
 
 Constraint rows are scaled to the stiffness (as in :mod:`arlequin.solvers.static`): their
 entries (m² for L2 coupling) can be 1e13 times smaller than the stiffness's (N/m).
+
+The systems of the iterations are factorised by a :class:`~arlequin.solvers.direct.
+SparseDirectSolver` (``linear_solver``: SuperLU, or PARDISO which keeps its symbolic analysis
+from one iteration to the next); K_LL, factorised once, stays with SuperLU.
 """
 
 from __future__ import annotations
 
 import logging
+import time
 
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..problem.system import CoupledSystem
+from .direct import SparseDirectSolver
 from .operators import SystemOperators
 
 __all__ = ["MAX_CONDENSED_ENTRIES", "MIN_LINEAR_SHARE", "SaddleSolver"]
@@ -57,6 +63,8 @@ class SaddleSolver:
         Its operators (which blocks are linear, their assembled stiffness).
     condense : bool
         Condense the linear blocks (see the module docstring).
+    linear_solver : {"auto", "superlu", "pardiso"}
+        The backend of the iterations' factorisations (:mod:`arlequin.solvers.direct`).
 
     Attributes
     ----------
@@ -67,9 +75,19 @@ class SaddleSolver:
     n_multipliers : int
     condensed : bool
         Whether the linear blocks are condensed.
+    direct : SparseDirectSolver
+        The iterations' factorisations; ``direct.name`` the backend, ``direct.timings`` the
+        seconds spent factorising and solving (with K_LL's solves).
     """
 
-    def __init__(self, system: CoupledSystem, ops: SystemOperators, condense: bool = True):
+    def __init__(
+        self,
+        system: CoupledSystem,
+        ops: SystemOperators,
+        condense: bool = True,
+        linear_solver: str = "auto",
+    ):
+        self.direct = SparseDirectSolver(linear_solver)
         self.system, self.ops = system, ops
         n = system.n_dofs
         dirichlet = [
@@ -185,36 +203,25 @@ class SaddleSolver:
         m = self.n_multipliers
         mat = sp.bmat([[kff, self._bf.T], [self._bf, None]], format="csc") if m else kff.tocsc()
         rhs = np.concatenate([r_free, rc])
-        sol = _factor_solve(mat, rhs)
+        sol = self.direct.factor(mat).solve(rhs)
         return sol[: self.free.size], sol[self.free.size :]
 
     def _solve_condensed(self, kt, r_free, rc):
         kf = kt[self.free][:, self.free]
         knn = kf[self._N][:, self._N]
         r_l, r_n = r_free[self._L], r_free[self._N]
-        kinv_rl = self._kll.solve(r_l)
+        kinv_rl = self._kll_solve(r_l)
         mat = sp.bmat([[knn, self._bn.T], [self._bn, -self._s]], format="csc")
         rhs = np.concatenate([r_n, rc - self._bl @ kinv_rl])
-        sol = _factor_solve(mat, rhs)
+        sol = self.direct.factor(mat).solve(rhs)
         x_n, y = sol[: self._N.size], sol[self._N.size :]
         x = np.empty(self.free.size)
         x[self._N] = x_n
-        x[self._L] = kinv_rl - self._kll.solve(self._bl.T @ y)
+        x[self._L] = kinv_rl - self._kll_solve(self._bl.T @ y)
         return x, y
 
-
-def _factor_solve(mat: sp.csc_matrix, rhs: np.ndarray) -> np.ndarray:
-    """SuperLU with one step of iterative refinement."""
-    zero_diag = np.count_nonzero(mat.diagonal() == 0.0)
-    # few multiplier rows: threshold pivoting keeps the diagonal, so the symmetric ordering of
-    # A + Aᵀ fits (the plate: 0.61 -> 0.32 s a factorisation); many: partial pivoting, COLAMD
-    if zero_diag < 0.1 * mat.shape[0]:
-        permc, threshold, options = "MMD_AT_PLUS_A", 0.01, {"SymmetricMode": True}
-    else:
-        permc, threshold, options = "COLAMD", 1.0, {}
-    try:
-        lu = spla.splu(mat, permc_spec=permc, diag_pivot_thresh=threshold, options=options)
-    except RuntimeError as exc:  # "Factor is exactly singular"
-        raise np.linalg.LinAlgError(str(exc)) from exc
-    x = lu.solve(rhs)
-    return x + lu.solve(rhs - mat @ x)
+    def _kll_solve(self, rhs: np.ndarray) -> np.ndarray:
+        t0 = time.perf_counter()
+        x = self._kll.solve(rhs)
+        self.direct.timings["solve_s"] += time.perf_counter() - t0
+        return x

@@ -93,11 +93,14 @@ class SystemOperators:
     tangent : {"consistent", "initial"}
         Tangent of nonlinear terms (see the module docstring). With ``"consistent"`` a nonlinear
         model without the ``"tangent"`` capability is refused when a tangent is first needed.
+    with_mass : bool
+        Assemble the mass (False for the quasi-static solver, which has none: the consistent
+        mass of the 3D sphere's eighth at 31,722 dofs takes 5.5 s to assemble).
 
     Attributes
     ----------
-    mass : ndarray (n,) or sparse (n, n)
-        Weighted mass (kg).
+    mass : ndarray (n,), sparse (n, n) or None
+        Weighted mass (kg); None without ``with_mass``.
     inv_mass : ndarray (n,) or None
         Inverse lumped mass (1/kg).
     stiffness : sparse (n, n)
@@ -107,7 +110,13 @@ class SystemOperators:
         Every block linear.
     """
 
-    def __init__(self, system: CoupledSystem, lumped: bool, tangent: str = "consistent") -> None:
+    def __init__(
+        self,
+        system: CoupledSystem,
+        lumped: bool,
+        tangent: str = "consistent",
+        with_mass: bool = True,
+    ) -> None:
         if tangent not in TANGENTS:
             raise ValueError(f"tangent must be one of {TANGENTS}, got {tangent!r}")
         self.system = system
@@ -124,9 +133,9 @@ class SystemOperators:
         self.offsets = self.dofmap.offsets
         self.block_of_dof = self.dofmap.block_of_dof
         self.names = [b.name for b in self.blocks]
-        mass = system.mass(lumped=self.lumped)
+        mass = system.mass(lumped=self.lumped) if with_mass else None
         self.mass = mass
-        if self.lumped:
+        if self.lumped and with_mass:
             mass = np.asarray(mass, dtype=float)
             bad = np.nonzero(~(mass > 0.0))[0]
             if bad.size:

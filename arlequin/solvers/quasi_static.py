@@ -24,7 +24,15 @@ further (``min_step``), the run stops and says why: a limit load (the structure'
 capacity: the incremental stiffness had dropped, or the tangent became singular), a
 ``StateError``, or a Newton failure. Linear blocks (the coarse elastic models) are condensed
 once for the whole run (:mod:`arlequin.solvers.condensation`): each Newton iteration factors
-only the nonlinear blocks and the multipliers.
+only the nonlinear blocks and the multipliers. The factorisations use a sparse direct solver
+(``linear_solver``: SuperLU, or PARDISO where pypardiso is installed, which keeps its symbolic
+analysis from one iteration of a load step to the next: :mod:`arlequin.solvers.direct`).
+
+Timings: the solver adds up, over its load steps (failed attempts included), the wall time of
+the models' internal forces, return maps and tangent assembly, of the factorisations, of the
+solves, and the rest (residuals, line search, the condensation's products): a few
+``time.perf_counter`` calls a Newton iteration, in :attr:`QuasiStaticSolver.timings` and the
+result's ``timings``.
 
 Units: SI (λ dimensionless, displacements m, forces N).
 """
@@ -33,18 +41,25 @@ from __future__ import annotations
 
 import logging
 import math
-import warnings
+import time
 from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
 
-from ..contract import CoarseYieldWarning, StateError
+from ..contract import StateError
 from .adaptive import AdaptableSolver, run_adaptive
 from .condensation import SaddleSolver
 from .constraints import is_unilateral
+from .direct import resolve_linear_solver
 from .operators import SystemOperators, as_system, as_vector
-from .quasi_static_result import STATUSES, NewtonError, QuasiStaticResult, QuasiStaticStep
+from .quasi_static_result import (
+    STATUSES,
+    CoarseYieldWatch,
+    NewtonError,
+    QuasiStaticResult,
+    QuasiStaticStep,
+)
 
 __all__ = [
     "STATUSES",
@@ -97,6 +112,9 @@ class QuasiStaticSolver(AdaptableSolver):
     condense : bool
         Condense the linear blocks once (True) or factor the whole saddle point at every
         iteration (False, the reference).
+    linear_solver : {"auto", "superlu", "pardiso"}
+        The sparse direct solver of the Newton systems (:mod:`arlequin.solvers.direct`):
+        ``"auto"`` is PARDISO where the optional pypardiso is installed, else SuperLU.
     reference_time : float
         With ``proportional``, the time (s) at which the system's loads and prescribed values
         are taken as those of λ = 1 (default 1).
@@ -106,6 +124,13 @@ class QuasiStaticSolver(AdaptableSolver):
         A :meth:`checkpoint` of an interrupted run of the same problem and options: the solver
         continues from its last converged step, with the same steps and values as the
         uninterrupted run.
+
+    Attributes
+    ----------
+    timings : dict
+        Seconds (wall time) spent in :meth:`step` so far: ``"constitutive_and_tangent_s"``
+        (internal forces, return maps, tangent assembly), ``"factorisation_s"``, ``"solve_s"``
+        and ``"other_s"`` (the rest); see the module docstring.
     """
 
     def __init__(
@@ -122,6 +147,7 @@ class QuasiStaticSolver(AdaptableSolver):
         line_search: bool = True,
         max_backtracks: int = 6,
         condense: bool = True,
+        linear_solver: str = "auto",
         reference_time: float = 1.0,
         t0: float = 0.0,
         u0: Any = None,
@@ -136,6 +162,7 @@ class QuasiStaticSolver(AdaptableSolver):
                 f"the quasi-static solver takes equality constraints only, got the unilateral "
                 f"constraint {type(unilateral[0]).__name__}: contact needs a dynamic integrator"
             )
+        resolve_linear_solver(linear_solver)  # a bad name before any work
         self.load, self.t0 = float(load), float(t0)
         self.nominal = (self.load - self.t0) / int(steps)
         self.min_step = float(min_step) if min_step is not None else self.nominal / 2**10
@@ -146,10 +173,13 @@ class QuasiStaticSolver(AdaptableSolver):
         self.max_iterations, self.growth = int(max_iterations), float(growth)
         self.easy_iterations, self.line_search = int(easy_iterations), bool(line_search)
         self.max_backtracks = int(max_backtracks)
-        self.ops = SystemOperators(self.system, lumped=False)
+        self.ops = SystemOperators(self.system, lumped=False, with_mass=False)
         self.ops.check_tangents("the quasi-static solver")
         self.condense = bool(condense)
-        self.saddle = SaddleSolver(self.system, self.ops, condense=condense)
+        self.linear_solver = linear_solver
+        self.saddle = SaddleSolver(self.system, self.ops, condense=condense,
+                                   linear_solver=linear_solver)  # fmt: skip
+        self._timers = {"constitutive_and_tangent_s": 0.0, "step_s": 0.0}
         self.t = self.t0
         self.u = as_vector(u0, self.system, "u0")
         self.states = states if states is not None else self.ops.initial_states()
@@ -199,11 +229,13 @@ class QuasiStaticSolver(AdaptableSolver):
         """Newton at load factor ``lam`` from the committed state; returns the converged
         (u, μ, trial states, residual history) or raises :class:`_StepFailed`."""
         fixed_values, _ = self.prescribed(lam)
+        # PARDISO's pivoting from this step's first tangent (a resumed run factorises alike)
+        self.saddle.direct.renew_analysis()
         u, mu = self._predictor(lam)
         u[self.saddle.fixed] = fixed_values
         history: list[float] = []
         try:
-            f_int, trial, kt = self.ops.internal_force(u, self.states, tangent=True)
+            f_int, trial, kt = self._internal_force(u, tangent=True)
         except StateError as exc:
             raise _StepFailed(str(exc), "state") from exc
         r_free, rc, rel = self._residual_of(f_int, u, mu, lam)
@@ -248,9 +280,28 @@ class QuasiStaticSolver(AdaptableSolver):
     def _evaluate(self, u, lam, tangent: bool):
         """(f_int, trial states, tangent or None), or None where a model refuses u."""
         try:
-            return self.ops.internal_force(u, self.states, tangent=tangent)
+            return self._internal_force(u, tangent)
         except StateError:
             return None
+
+    def _internal_force(self, u, tangent: bool):
+        """The models' internal forces (and tangent) at u from the committed states, timed."""
+        t0 = time.perf_counter()
+        try:
+            return self.ops.internal_force(u, self.states, tangent=tangent)
+        finally:
+            self._timers["constitutive_and_tangent_s"] += time.perf_counter() - t0
+
+    @property
+    def timings(self) -> dict[str, float]:
+        """Seconds spent in :meth:`step` so far, split (see the class docstring)."""
+        split = {
+            "constitutive_and_tangent_s": self._timers["constitutive_and_tangent_s"],
+            "factorisation_s": self.saddle.direct.timings["factorisation_s"],
+            "solve_s": self.saddle.direct.timings["solve_s"],
+        }
+        split["other_s"] = max(self._timers["step_s"] - sum(split.values()), 0.0)
+        return split
 
     def _update(self, u, mu, du, dmu, rel, lam):
         """The Newton update u + s Δu, μ + s Δμ: s = 1, or with the line search the largest of
@@ -277,7 +328,7 @@ class QuasiStaticSolver(AdaptableSolver):
                 break
             s *= 0.5
         if kt is None:
-            f_int, trial, kt = self.ops.internal_force(u_try, self.states, tangent=True)
+            f_int, trial, kt = self._internal_force(u_try, tangent=True)
         return u_try, mu_try, f_int, trial, kt
 
     def step(self) -> QuasiStaticStep:
@@ -289,6 +340,13 @@ class QuasiStaticSolver(AdaptableSolver):
             The step could not be cut further (a StateError or a Newton failure there, not a
             limit load: that sets ``status`` to ``"limit_load"`` and returns None).
         """
+        t0 = time.perf_counter()
+        try:
+            return self._step()
+        finally:
+            self._timers["step_s"] += time.perf_counter() - t0
+
+    def _step(self) -> QuasiStaticStep:
         cuts = 0
         while True:
             dt = min(self.dt, self.load - self.t)
@@ -376,9 +434,12 @@ class QuasiStaticSolver(AdaptableSolver):
         onto it at the same load factor (blocks missing from ``states``: initial states); the
         multipliers are zero until :meth:`resolve`."""
         self.system = as_system(system)
-        self.ops = SystemOperators(self.system, lumped=False)
+        self.ops = SystemOperators(self.system, lumped=False, with_mass=False)
         self.ops.check_tangents("the quasi-static solver")
-        self.saddle = SaddleSolver(self.system, self.ops, condense=self.condense)
+        timings = self.saddle.direct.timings
+        self.saddle = SaddleSolver(self.system, self.ops, condense=self.condense,
+                                   linear_solver=self.linear_solver)  # fmt: skip
+        self.saddle.direct.timings = timings  # the run's, across the growths
         self.u = as_vector(u, self.system, "u")
         self.states = {**self.ops.initial_states(), **states}
         self.mu = np.zeros(self.saddle.n_multipliers)
@@ -391,11 +452,14 @@ class QuasiStaticSolver(AdaptableSolver):
         load factor, for the next step's predictor (without it the next step starts from the
         committed fields, as the first step)."""
         self.mu = self._least_squares_multipliers()
+        t0 = time.perf_counter()
         try:
             u, mu, trial, history = self._newton(self.t)
         except _StepFailed as fail:
             raise NewtonError(f"re-solving the grown patch at λ = {self.t:.6g} failed: {fail}",
                               step=len(self.history), time=self.t) from fail  # fmt: skip
+        finally:
+            self._timers["step_s"] += time.perf_counter() - t0  # counted with the steps
         self.u, self.mu, self.states = u, mu, trial
         if previous is not None:  # the multipliers' increment is not known: none
             self._previous = (np.asarray(previous[0], dtype=float), mu, float(previous[1]))
@@ -427,6 +491,8 @@ class QuasiStaticSolver(AdaptableSolver):
             states=self.states,
             limit_load=self.t if status == "limit_load" else None,
             system=self.system,
+            linear_solver=self.saddle.direct.name,
+            timings=self.timings,
         )
 
 
@@ -483,8 +549,8 @@ def solve_quasi_static(
         adapt)`` member are told of each growth.
     **options
         Passed to :class:`QuasiStaticSolver` (``proportional``, ``tol``, ``max_iterations``,
-        ``min_step``, ``growth``, ``line_search``, ``condense``, ``reference_time``, ``t0``,
-        ``u0``, ``states``, ``restore``).
+        ``min_step``, ``growth``, ``line_search``, ``condense``, ``linear_solver``,
+        ``reference_time``, ``t0``, ``u0``, ``states``, ``restore``).
 
     Returns
     -------
@@ -505,7 +571,7 @@ def solve_quasi_static(
     solver = QuasiStaticSolver(problem, load=load, steps=steps, **options)
     if adapt is not None:
         return run_adaptive(solver, adapt, on_step, callback)
-    watch = _CoarseYieldWatch(problem)
+    watch = CoarseYieldWatch(problem)
     while solver.status == "running":
         try:
             rec = solver.step()
@@ -521,37 +587,3 @@ def solve_quasi_static(
             solver.status = "stopped"
             return watch.finish(solver.result(f"stopped by the callback at λ = {solver.t:.6g}"))
     return watch.finish(solver.result())
-
-
-class _CoarseYieldWatch:
-    """The largest coarse von Mises / σy outside the patches over the steps, for a problem that
-    can tell it (``coarse_yield_ratio``, an ``ArlequinProblem`` with J2 patches); a
-    :class:`~arlequin.contract.CoarseYieldWarning` once it passes 1."""
-
-    def __init__(self, problem: Any) -> None:
-        self.ratio_of = getattr(problem, "coarse_yield_ratio", None)
-        self.worst: float | None = None
-        self.warned = False
-
-    def __call__(self, solver: Any) -> None:
-        if self.ratio_of is None:
-            return
-        ratio = self.ratio_of(solver.u)
-        if ratio is None:
-            self.ratio_of = None
-            return
-        self.worst = ratio if self.worst is None else max(self.worst, ratio)
-        if ratio > 1.0 and not self.warned:
-            self.warned = True
-            warnings.warn(
-                f"at λ = {solver.t:.6g} the coarse model outside the patches carries von Mises "
-                f"stresses {ratio:.3f} times the patches' yield stress: the plastic zone has "
-                "outgrown the patches (the results past this load are not those of the "
-                "elastoplastic material: widen the patches, or use an AdaptivePatch)",
-                CoarseYieldWarning,
-                stacklevel=3,
-            )
-
-    def finish(self, result: QuasiStaticResult) -> QuasiStaticResult:
-        result.max_coarse_yield_ratio = self.worst
-        return result

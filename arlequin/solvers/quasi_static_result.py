@@ -3,15 +3,16 @@
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from ..contract import SimulationError
+from ..contract import CoarseYieldWarning, SimulationError
 from ..problem.system import CoupledSystem
 
-__all__ = ["STATUSES", "NewtonError", "QuasiStaticResult", "QuasiStaticStep"]
+__all__ = ["STATUSES", "CoarseYieldWatch", "NewtonError", "QuasiStaticResult", "QuasiStaticStep"]
 
 #: How a quasi-static run ends: the target load reached, a limit load, a stop asked by the
 #: callback.
@@ -72,6 +73,12 @@ class QuasiStaticResult:
         Block name -> the committed model states of its terms.
     limit_load : float or None
         The last converged λ when the run ended at a limit load.
+    linear_solver : str
+        The sparse direct solver of the Newton systems (``"superlu"`` or ``"pardiso"``).
+    timings : dict
+        Seconds (wall time) of the load steps: ``"constitutive_and_tangent_s"``,
+        ``"factorisation_s"``, ``"solve_s"``, ``"other_s"``
+        (:attr:`QuasiStaticSolver.timings <arlequin.solvers.quasi_static.QuasiStaticSolver>`).
     """
 
     status: str
@@ -91,6 +98,8 @@ class QuasiStaticResult:
     adaptations: list[Any] = field(default_factory=list)
     max_coarse_yield_ratio: float | None = None
     problem: Any = field(default=None, repr=False)
+    linear_solver: str = "superlu"
+    timings: dict[str, float] = field(default_factory=dict)
 
     @property
     def newton_iterations(self) -> list[int]:
@@ -101,3 +110,37 @@ class QuasiStaticResult:
     def residuals(self) -> list[list[float]]:
         """Relative residuals of every converged step's iterations."""
         return [list(s.residuals) for s in self.steps]
+
+
+class CoarseYieldWatch:
+    """The largest coarse von Mises / σy outside the patches over the steps, for a problem that
+    can tell it (``coarse_yield_ratio``, an ``ArlequinProblem`` with J2 patches); a
+    :class:`~arlequin.contract.CoarseYieldWarning` once it passes 1."""
+
+    def __init__(self, problem: Any) -> None:
+        self.ratio_of = getattr(problem, "coarse_yield_ratio", None)
+        self.worst: float | None = None
+        self.warned = False
+
+    def __call__(self, solver: Any) -> None:
+        if self.ratio_of is None:
+            return
+        ratio = self.ratio_of(solver.u)
+        if ratio is None:
+            self.ratio_of = None
+            return
+        self.worst = ratio if self.worst is None else max(self.worst, ratio)
+        if ratio > 1.0 and not self.warned:
+            self.warned = True
+            warnings.warn(
+                f"at λ = {solver.t:.6g} the coarse model outside the patches carries von Mises "
+                f"stresses {ratio:.3f} times the patches' yield stress: the plastic zone has "
+                "outgrown the patches (the results past this load are not those of the "
+                "elastoplastic material: widen the patches, or use an AdaptivePatch)",
+                CoarseYieldWarning,
+                stacklevel=3,
+            )
+
+    def finish(self, result: QuasiStaticResult) -> QuasiStaticResult:
+        result.max_coarse_yield_ratio = self.worst
+        return result
