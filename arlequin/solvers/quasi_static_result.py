@@ -142,5 +142,7 @@ class CoarseYieldWatch:
             )
 
     def finish(self, result: QuasiStaticResult) -> QuasiStaticResult:
+        """``result`` with the largest ratio seen (``max_coarse_yield_ratio``; None if the
+        problem has no coarse yield check)."""
         result.max_coarse_yield_ratio = self.worst
         return result
