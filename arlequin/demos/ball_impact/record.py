@@ -120,7 +120,9 @@ class ImpactRecorder:
     def on_adapt(self, integ, adapt) -> None:
         """The block's patch grew: the measures follow the new set-up, the balance moves by
         the growth's energy change (recorded with the growth)."""
-        self.bodies.regrow(adapt.problem)
+        # the grown system and contact the integrator runs on (not built twice)
+        contact = next((c for c in integ.unilateral if c.name == "contact"), None)
+        self.bodies.regrow(adapt.problem, integ.system, contact)
         change = adapt.records[-1].energy_change
         if self._e0 is not None and change is not None:
             self._e0 += change
