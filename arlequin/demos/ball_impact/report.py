@@ -134,8 +134,8 @@ class AdaptationPictures:
         """The picture of the patch just grown."""
         self.count += 1
         rec = adapt.records[-1]
-        title = (f"growth {self.count} at t = {rec.time * 1e6:.3g} µs (step {rec.step}): "
-                 f"{rec.patch_fraction:.3f} of the block's area")  # fmt: skip
+        title = (f"growth {self.count}, t = {rec.time * 1e6:.3g} µs (step {rec.step}): "
+                 f"{rec.patch_fraction:.3f} of the block")  # fmt: skip
         plot_block_patch(self.bodies, integ.states,
                          str(self.folder.picture(f"patch_{self.count}")), title)  # fmt: skip
 
