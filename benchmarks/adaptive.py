@@ -15,8 +15,15 @@ Cases (``--case``):
             the final patch's gluing band (``patch_over_plastic_zone_and_band``; also over the
             plastic zone's coarse cells and one ring, ``patch_over_plastic_cover``),
             T_mono / T_adaptive ≥ 8.
-``ball``    (the ball impact: to be added with the explicit adaptation; a function
-            ``ball_case(repeat, memory) -> dict`` registered in :data:`CASES`.)
+``ball``    the ball impact, plastic regime (copper block, 10 m/s, multi-time-step M = 2), the
+            set-up of ``tests/test_ball_impact.py``'s plastic runs (block R_B = H_B = 2 R,
+            coarse π R/80, fine π R/160; ``--size quick``: coarse π R/32, the seed 0.45 R,
+            3 m/s, to check the benchmark in minutes): adaptive from the seed of radius 0.4 R
+            at the contact point, the demo's fixed block patch (0.8 R), mono. Criterion 5:
+            dent depth, peak force and restitution within 2% of mono, T_mono / T_adaptive ≥
+            0.8 T_mono / T_fixed. The time adapting: the rebuilt problem and contact, the
+            moved fields, the new integrator (stable step, impulse factorisation), its first
+            impulse, the rejected intervals.
 
 For each run: the wall time (the shortest of ``--repeat`` rounds, the three models
 alternating), the number of growths, the time spent adapting (rebuilding the patch, its
@@ -25,13 +32,17 @@ re-solve at the same load; the rejected steps computed again) and its share of t
 final patch fraction, the largest coarse σ_vm/σy outside the patch, and the peak traced memory
 (one more run under :mod:`tracemalloc`, unless ``--no-memory``). Prints JSON.
 
-    python benchmarks/adaptive.py [--case {sphere,plate,all}] [--repeat 1] [--no-memory]
+    python benchmarks/adaptive.py [--case {sphere,plate,ball,all}] [--repeat 1] [--no-memory]
+                                  [--size {full,quick}]
 """
 
 from __future__ import annotations
 
 import argparse
+import functools
 import json
+import math
+import sys
 import time
 import tracemalloc
 import warnings
@@ -53,6 +64,10 @@ def _timed(runs: dict[str, Callable[[], object]], repeat: int) -> tuple[dict, di
             results[name] = fn()
             wall = time.perf_counter() - start
             best[name] = min(best.get(name, np.inf), wall)
+            # progress on stderr: a long case's figures before its JSON
+            summary = getattr(results[name], "summary", None)
+            print(f"{name}: {wall:.1f} s", summary() if callable(summary) else "",
+                  file=sys.stderr, flush=True)  # fmt: skip
     return results, best
 
 
@@ -196,8 +211,74 @@ def plate_case(repeat: int, memory: bool) -> dict:
     return out
 
 
-#: The cases, by ``--case`` name (the ball impact joins with the explicit adaptation).
-CASES: dict[str, Callable[[int, bool], dict]] = {"sphere": sphere_case, "plate": plate_case}
+#: The ball impact's configurations (``--size``): the keywords of ``run_ball_impact`` (SI).
+BALL_SIZES = {
+    "full": {"regime": "plastic", "block_radius": 0.02, "block_height": 0.02,
+             "coarse_size": 0.25 * math.pi * 0.01 / 20},
+    # coarser: the seed widened to 0.45 R and 3 m/s, so that the contact stays on the contact
+    # surfaces (patch_size − 3 coarse cells)
+    "quick": {"regime": "plastic", "block_radius": 0.02, "block_height": 0.02,
+              "coarse_size": 0.25 * math.pi * 0.01 / 8, "velocity": 3.0, "patch_size": 0.0045},
+}  # fmt: skip
+
+#: The measures of criterion 5, compared with mono's.
+BALL_MEASURES = ("dent_depth", "peak_force", "restitution")
+
+
+def ball_case(repeat: int, memory: bool, size: str = "full") -> dict:
+    """The ball impact, plastic regime, adaptive / fixed patch / mono (criterion 5)."""
+    from arlequin.demos.ball_impact import run_ball_impact
+
+    kw = BALL_SIZES[size]
+    runs = {
+        "adaptive": lambda: run_ball_impact(adaptive=True, **kw),
+        "fixed": lambda: run_ball_impact(**kw),
+        "mono": lambda: run_ball_impact(model="mono", **kw),
+    }
+    results, best = _timed(runs, repeat)
+    out: dict = {"size": size, "config": dict(kw)}
+    for name, r in results.items():
+        out[name] = {
+            "wall_time_s": best[name],
+            "n_elements": r.n_elements,
+            "n_steps": r.n_steps,
+            # the patches' elements over those of mono's meshes (mono: 1)
+            "patch_fraction": r.patch_fraction,
+            **{k: getattr(r, k) for k in BALL_MEASURES},
+            "contact_duration_s": r.contact_duration,
+            "max_plastic_strain": r.max_plastic_strain,
+            "band_max_plastic_strain": r.band_max_plastic_strain,
+            "energy_balance_error": r.energy_balance_error,
+        }
+    a = results["adaptive"]
+    out["adaptive"].update(_adapt_figures(a.adaptations, best["adaptive"]))
+    out["adaptive"]["block_patch_fraction"] = (a.adaptations[-1]["patch_fraction"]
+                                               if a.adaptations else None)  # fmt: skip
+    out["adaptive"]["max_coarse_yield_ratio"] = a.max_coarse_yield_ratio
+    _with_memory(out, runs, memory)
+    m, f = out["mono"], out["fixed"]
+    t_mono_over_fixed = m["wall_time_s"] / f["wall_time_s"]
+    out["criterion_5"] = {
+        **{f"{k}_deviation": out["adaptive"][k] / m[k] - 1.0 for k in BALL_MEASURES},
+        **{f"fixed_{k}_deviation": f[k] / m[k] - 1.0 for k in BALL_MEASURES},
+        "T_mono_over_T_adaptive": m["wall_time_s"] / out["adaptive"]["wall_time_s"],
+        "T_mono_over_T_fixed": t_mono_over_fixed,
+        "bound_0.8_T_mono_over_T_fixed": 0.8 * t_mono_over_fixed,
+        "T_fixed_over_T_adaptive": f["wall_time_s"] / out["adaptive"]["wall_time_s"],
+        "targets": {
+            "deviations": "|.| <= 0.02",
+            "T_mono_over_T_adaptive": ">= 0.8 T_mono_over_T_fixed",
+        },
+    }
+    return out
+
+
+#: The cases, by ``--case`` name.
+CASES: dict[str, Callable[..., dict]] = {
+    "sphere": sphere_case,
+    "plate": plate_case,
+    "ball": ball_case,
+}
 
 
 def main(argv=None) -> dict:
@@ -205,13 +286,19 @@ def main(argv=None) -> dict:
     parser.add_argument("--case", choices=(*CASES, "all"), default="all")
     parser.add_argument("--repeat", type=int, default=1)
     parser.add_argument("--no-memory", action="store_true", help="skip the tracemalloc runs")
+    parser.add_argument("--size", choices=tuple(BALL_SIZES), default="full",
+                        help="the ball impact's configuration (quick: coarser, to check the "
+                        "benchmark)")  # fmt: skip
     args = parser.parse_args(argv)
     names = list(CASES) if args.case == "all" else [args.case]
     out: dict = {"repeat": args.repeat, "threads": _threads.settings(), "cases": {}}
     with warnings.catch_warnings():  # the JSON gives the coarse-yield figures
         warnings.simplefilter("ignore")
         for name in names:
-            out["cases"][name] = CASES[name](args.repeat, not args.no_memory)
+            case = CASES[name]
+            if name == "ball":
+                case = functools.partial(case, size=args.size)
+            out["cases"][name] = case(args.repeat, not args.no_memory)
     print(json.dumps(out, indent=2, default=float))
     return out
 

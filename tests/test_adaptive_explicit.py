@@ -405,3 +405,42 @@ def test_ball_impact_adaptive_against_the_uniform_mesh(tmp_path):
                                "energy_jump"}  # fmt: skip
         assert abs(growth["energy_jump"]) <= 1e-3
     assert adaptive["band_max_plastic_strain"] == 0.0
+
+
+def test_ball_impact_adaptive_pictures_and_patch_history_on_disk(tmp_path):
+    """The adaptive run's results folder (a tiny set-up: coarse π R/32, the seed 0.45 R,
+    7 m/s, checked every 10 steps, capped at 9% of the block so that the cap stops it at
+    11 µs, 5 s of CPU): ``patch_K.png`` after each growth, ``patch_size.png`` (kept when the
+    cap stops the run), the patch's share per row of ``impact.csv`` following the growths,
+    the grown patch's field series (opened by meshio) and each growth's timers."""
+    from arlequin.demos.ball_impact import run_ball_impact
+    from arlequin.io import read_history, read_series
+
+    tiny = {**BALL, "coarse_size": 0.25 * np.pi * 0.01 / 8, "velocity": 7.0,
+            "patch_size": 0.0045}  # fmt: skip
+    with pytest.raises(PatchLimitError, match="max_fraction") as info:
+        run_ball_impact(adaptive=True, adapt_every=10, max_patch_fraction=0.09, out=tmp_path,
+                        **tiny)  # fmt: skip
+    growths = info.value.result.adaptations
+    # recorded (this set-up, 2026-12-04): growths at steps 50, 80, 100 to 0.0554, 0.0651,
+    # 0.0747 of the block; the next (to 0.094, step 210) refused by the cap
+    assert [g.step for g in growths] == [50, 80, 100]
+    assert info.value.step == 210
+    for k in range(1, len(growths) + 1):
+        assert (tmp_path / f"patch_{k}.png").stat().st_size > 0
+    assert not (tmp_path / f"patch_{len(growths) + 1}.png").exists()
+    assert (tmp_path / "patch_size.png").stat().st_size > 0
+    rows = read_history(tmp_path / "impact.csv")
+    t, share = np.asarray(rows["t"]), np.asarray(rows["patch_fraction"])
+    assert np.all(np.diff(share) >= 0.0)
+    for g in growths:  # the rows before a growth show the patch before it, those after it
+        assert np.all(share[t > g.time + 1e-12] >= g.patch_fraction - 1e-15)
+        assert np.all(share[t <= g.time - 1e-12] < g.patch_fraction)
+    assert share[-1] == growths[-1].patch_fraction
+    # the one frame (t_end / 10 = 9.8 µs) after the third growth: its own series
+    mesh, frames = read_series(tmp_path / "fields" / "block.patch_3.xdmf")
+    assert len(frames) == 1 and frames[0][0] > growths[-1].time
+    assert mesh.cells[0].data.shape[0] == growths[-1].n_fine_elements
+    for g in growths:  # the explicit growths' timers, as the quasi-static ones
+        assert g.wall_time_s > 0.0 and g.system_time_s > 0.0 and g.resolve_time_s > 0.0
+        assert g.discarded_time_s == 0.0 and not g.rejected

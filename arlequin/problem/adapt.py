@@ -105,11 +105,15 @@ class Adaptation:
         Time spent rebuilding the patch (its mesh, model, overlap, weights, gluing band,
         coupling rows) and transferring the fields (s).
     system_time_s : float
-        Time the solver spent on the new system's operators and saddle-point solver (s).
+        Time the solver spent on the new system's operators and saddle-point solver (s;
+        explicit runs: the new integrator, its stable step and impulse factorisation, and the
+        rebuilt constraints).
     resolve_time_s : float
-        Time of the re-solve of the multipliers and fields at the same load (s).
+        Time of the re-solve of the multipliers and fields at the same load (s; explicit
+        runs: the new integrator's first impulse and the energies across the growth).
     discarded_time_s : float
-        Time of the rejected step computed again after the growth (s; 0 if accepted).
+        Time of the rejected step (explicit runs: interval) computed again after the growth
+        (s; 0 if accepted).
     """
 
     step: int

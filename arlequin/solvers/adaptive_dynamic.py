@@ -20,7 +20,12 @@ multi-time-step scheme at its macro times only). At a check the adaptation objec
   records taken since), the patch grows from that state and the interval is computed again.
 
 Each growth records the relative jump of the total energy across it (``energy_jump``: the
-scheme's kinetic energy plus the stored energy and the plastic dissipation of every block);
+scheme's kinetic energy plus the stored energy and the plastic dissipation of every block) and
+the time of its parts, as a quasi-static growth does (:class:`~arlequin.problem.adapt.Adaptation`:
+``wall_time_s`` the rebuilt problem and the moved fields, ``system_time_s`` the new integrator
+(its operators, stable step, impulse factorisation, the rebuilt constraints),
+``resolve_time_s`` its first impulse from the moved fields (the multipliers re-solved) and the
+energies across the growth, ``discarded_time_s`` the rejected interval's steps);
 listeners with an ``on_adapt(integrator, adapt)`` member hear of it (after a rejected interval
 the integrator's time is the committed one, earlier than the last step they saw).
 """
@@ -30,6 +35,7 @@ from __future__ import annotations
 import dataclasses
 import logging
 import math
+import time
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -86,6 +92,7 @@ class DynamicAdapter:
         self._next_time: float | None = None
         self._late = False
         self._snap: tuple[Any, ...] | None = None
+        self._committed_at = time.perf_counter()
 
     # -- when -----------------------------------------------------------------------------
     def due(self, integ: Any, k: int, last: bool) -> bool:
@@ -113,12 +120,14 @@ class DynamicAdapter:
         integ = loop.integ
         try:
             growth = self.adapt.assess(integ, k, due=True)
-            rewound = False
+            rewound, discarded = False, 0.0
             if growth is not None and growth.reject and self._snap is not None:
+                # the interval's steps and its assessment, computed again after the growth
+                discarded = time.perf_counter() - self._committed_at
                 integ = self._rewind(loop)
                 rewound = True
             if growth is not None:
-                integ = self._grow(loop, integ, growth)
+                integ = self._grow(loop, integ, growth, discarded)
         except (SimulationError, ValueError) as err:
             err.result = finish_adaptive(loop.rec.result(-1, str(err)), self.adapt)
             raise
@@ -133,6 +142,7 @@ class DynamicAdapter:
         records = {name: len(v) for name, v in rec.records.items()}
         pending = None if loop.pending is None else list(loop.pending)
         self._snap = (integ, integ.snapshot(), lengths, mult, records, pending)
+        self._committed_at = time.perf_counter()
         if self.interval is not None:
             self._next_time = integ.t + self.interval
 
@@ -154,15 +164,18 @@ class DynamicAdapter:
         return integ
 
     # -- the growth -----------------------------------------------------------------------
-    def _grow(self, loop: Any, integ: Any, growth: Any) -> Any:
+    def _grow(self, loop: Any, integ: Any, growth: Any, discarded: float = 0.0) -> Any:
+        start = time.perf_counter()
         before = total_energy(integ)
         step, t = integ.step_count, integ.t
         problem, u, states = self.adapt.grow(growth, integ.u, integ.states, step, t)
         v = self.adapt.transfer_displacement(integ.v)
+        moved = time.perf_counter()
         changed = {}
         if integ.unilateral:  # contact pairs between bodies: rebuilt on the new dof map
             changed["constraints"] = self.adapt.constraints_for(problem)
         new = self.build(problem, t, u, v, **changed)
+        built = time.perf_counter()
         # the moved states (the old fine cells' own, the new ones virgin) replace the initial
         # ones the constructor started from: forces, impulse and multipliers again from them
         new.states = {**new.states, **states}
@@ -177,6 +190,11 @@ class DynamicAdapter:
         record = self.adapt.records[-1]
         record.energy_jump = (after - before) / abs(before) if before else 0.0
         record.energy_change = after - before
+        # the whole rebuild and transfer (a multi-body problem's too, and the velocity's),
+        # the new integrator, its first impulse and the energies
+        record.wall_time_s, record.system_time_s = moved - start, built - moved
+        record.resolve_time_s = time.perf_counter() - built
+        record.discarded_time_s = discarded
         logger.info(
             "t = %.6e s: patch grown, total energy %.9g -> %.9g J (jump %.3g), stable step "
             "%.4g s", t, before, after, record.energy_jump, float(new.critical_dt or math.nan),

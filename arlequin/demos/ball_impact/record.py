@@ -4,9 +4,10 @@
 and the contact's end) and the contact radius. At every sample (:data:`SAMPLES` over the run,
 and the last step): the integrator's energy balance and a history row (the contact force, the
 ball's mean velocity, the energies: kinetic, elastic, plastic dissipation, contact and coupling
-works), written to ``impact.csv`` as the run goes when a results folder is open. The energies
-cost a product with every linear stiffness, and the J2 model's stored energy 3.6 of its
-internal-force evaluations (measured), hence the samples. SI units.
+works; with an adaptive block patch, its share of the block's area), written to ``impact.csv``
+as the run goes when a results folder is open. The energies cost a product with every linear
+stiffness, and the J2 model's stored energy 3.6 of its internal-force evaluations (measured),
+hence the samples. SI units.
 """
 
 from __future__ import annotations
@@ -32,13 +33,18 @@ class ImpactRecorder:
         Simulated time (s), for the progress fraction.
     progress : callable, optional
         ``progress(fraction)`` at each new percent.
+    adapt : BodyAdaptation, optional
+        The adaptive block patch: each row gains its ``patch_fraction`` (its share of the
+        block's coarse mesh's (r, z) area, as in the growths' records).
     """
 
-    def __init__(self, bodies, folder, t_end: float, progress=None) -> None:
+    def __init__(self, bodies, folder, t_end: float, progress=None, adapt=None) -> None:
         self.bodies = bodies
         self.t_end = float(t_end)
         self.progress = progress
-        self.rows: dict[str, list[float]] = {k: [] for k in HISTORY_KEYS}
+        self.adapt = adapt
+        self.keys = HISTORY_KEYS + (("patch_fraction",) if adapt is not None else ())
+        self.rows: dict[str, list[float]] = {k: [] for k in self.keys}
         self.times: list[float] = []  # every step's time and contact force
         self.forces: list[float] = []
         self._next = 0.0
@@ -46,7 +52,7 @@ class ImpactRecorder:
         self.scale = 0.0
         self.contact_radius = 0.0
         self._pct = -1
-        self.csv = folder.history(list(HISTORY_KEYS), HISTORY_UNITS, name="impact") if folder \
+        self.csv = folder.history(list(self.keys), HISTORY_UNITS, name="impact") if folder \
             else None  # fmt: skip
         part = bodies.plastic_part()
         self._j2_block = None if part is None else part[1]
@@ -104,7 +110,9 @@ class ImpactRecorder:
                "contact_work": float(getattr(st, "work", 0.0)),
                "coupling_work": float(sum(e["coupling_work"].values())),
                "friction_work": float(getattr(st, "friction_work", 0.0))}  # fmt: skip
-        for k in HISTORY_KEYS:
+        if self.adapt is not None:  # a sum over the coarse cells' areas: cheap
+            row["patch_fraction"] = self.adapt.patch_fraction
+        for k in self.keys:
             self.rows[k].append(float(row[k]))
         if self.csv is not None:
             self.csv.append(row)
@@ -112,7 +120,9 @@ class ImpactRecorder:
     def on_adapt(self, integ, adapt) -> None:
         """The block's patch grew: the measures follow the new set-up, the balance moves by
         the growth's energy change (recorded with the growth)."""
-        self.bodies.regrow(adapt.problem)
+        # the grown system and contact the integrator runs on (not built twice)
+        contact = next((c for c in integ.unilateral if c.name == "contact"), None)
+        self.bodies.regrow(adapt.problem, integ.system, contact)
         change = adapt.records[-1].energy_change
         if self._e0 is not None and change is not None:
             self._e0 += change

@@ -34,7 +34,7 @@ HISTORY_KEYS = ("t", "contact_force", "ball_velocity", "kinetic", "elastic",
                 "friction_work")  # fmt: skip
 HISTORY_UNITS = {"t": "s", "contact_force": "N", "ball_velocity": "m/s", "kinetic": "J",
                   "elastic": "J", "plastic_dissipation": "J", "contact_work": "J",
-                  "coupling_work": "J", "friction_work": "J"}  # fmt: skip
+                  "coupling_work": "J", "friction_work": "J", "patch_fraction": "1"}  # fmt: skip
 INPUT_UNITS = {"regime": "", "model": "", "velocity": "m/s", "ball_radius": "m",
                "block_radius": "m", "block_height": "m", "patch_size": "m",
                "block_patch_size": "m", "fine_size": "m",
@@ -107,7 +107,8 @@ class BallImpactResult(JsonResult):
         ``elastic`` (strain energy of the elastic models and stored energy of the J2 one),
         ``plastic_dissipation``, ``contact_work`` (of the normal multipliers),
         ``coupling_work``, ``friction_work`` (of the tangential multipliers, ≤ 0; 0 without
-        friction) (J).
+        friction) (J); with ``adaptive``, ``patch_fraction`` (the block patch's share of the
+        block's coarse mesh's (r, z) area, 1).
     hertz : dict
         Hertz's values (elastic regime; empty otherwise).
     contact_radius_cells : float

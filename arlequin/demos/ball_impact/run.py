@@ -9,6 +9,7 @@ see :mod:`arlequin.demos.ball_impact`.
 from __future__ import annotations
 
 import contextlib
+import functools
 import logging
 import math
 import time
@@ -23,7 +24,7 @@ from ...io import DynamicRunWriter, ResultsFolder
 from ...solvers import solve
 from ..taylor_bar.result import GluingBandPlasticityWarning
 from .record import ImpactRecorder
-from .report import write_outputs
+from .report import AdaptationPictures, plot_patch_size, write_outputs
 from .result import BallImpactResult, hertz
 from .setup import ImpactBodies, ResolvedInputs, mono_cells
 
@@ -56,9 +57,15 @@ def run_config(config: BallImpactConfig, out: str | Path | None = None,
     t_end = _simulated_time(inputs, bodies, values)
     record = config.inputs()  # the resolved inputs, the materials as objects of their fields
     folder = ResultsFolder(out, "arlequin ball-impact", record, config.units()) if out else None
-    recorder = ImpactRecorder(bodies, folder, t_end, progress)
-    with _failures_recorded(folder):
-        res, wall = _time_loop(inputs, bodies, recorder, folder, t_end, adapt)
+    recorder = ImpactRecorder(bodies, folder, t_end, progress, adapt)
+    listeners = [recorder]
+    if folder is not None and adapt is not None:  # after the recorder: it follows the growths
+        listeners.append(AdaptationPictures(folder, bodies))
+    # a failed adaptive run (the patch's cap reached) keeps the patch's history picture too
+    keep = None if folder is None or adapt is None else functools.partial(
+        _patch_size_picture, folder, recorder, adapt)  # fmt: skip
+    with _failures_recorded(folder, keep):
+        res, wall = _time_loop(inputs, bodies, listeners, folder, t_end, adapt)
         # Arlequin: its patches' elements; a reference: all its elements, over the uniform
         # meshes'
         mono = mono_cells(inputs.sizes, inputs.block_radius, inputs.block_height,
@@ -115,15 +122,28 @@ def _simulated_time(inputs: ResolvedInputs, bodies: ImpactBodies,
 
 
 @contextlib.contextmanager
-def _failures_recorded(folder: ResultsFolder | None) -> Iterator[None]:
+def _failures_recorded(folder: ResultsFolder | None,
+                       keep: Callable[[], None] | None = None) -> Iterator[None]:  # fmt: skip
     """``with _failures_recorded(folder):`` an exception inside marks the results folder
-    failed (its message recorded) and propagates."""
+    failed (its message recorded, after ``keep()`` wrote what the run had) and propagates."""
     try:
         yield
     except Exception as exc:
         if folder is not None:
+            if keep is not None:
+                try:
+                    keep()
+                except Exception as err:  # the run's own error is the one to raise
+                    logger.warning("the failed run's pictures: %s", err)
             folder.finish("failed", str(exc))
         raise
+
+
+def _patch_size_picture(folder: ResultsFolder, recorder: ImpactRecorder, adapt: Any) -> None:
+    """``patch_size.png`` from the rows recorded so far (a failed adaptive run)."""
+    if recorder.rows["t"]:
+        growths = [(a.time, a.patch_fraction) for a in adapt.records]
+        plot_patch_size(recorder.rows, growths, str(folder.picture("patch_size")))
 
 
 def _integrator(inputs: ResolvedInputs, bodies: ImpactBodies) -> tuple[str, dict[str, Any]]:
@@ -135,11 +155,12 @@ def _integrator(inputs: ResolvedInputs, bodies: ImpactBodies) -> tuple[str, dict
     return "explicit-mts", options
 
 
-def _time_loop(inputs: ResolvedInputs, bodies: ImpactBodies, recorder: ImpactRecorder,
+def _time_loop(inputs: ResolvedInputs, bodies: ImpactBodies, listeners: list[Any],
                folder: ResultsFolder | None, t_end: float,
                adapt: Any = None) -> tuple[Any, float]:  # fmt: skip
-    """The explicit run to ``t_end`` (s): its final state and its wall time (s); ``adapt``
-    the adaptive block patch, if any."""
+    """The explicit run to ``t_end`` (s): its final state and its wall time (s); ``listeners``
+    called after every step (the :class:`ImpactRecorder` first), ``adapt`` the adaptive block
+    patch, if any."""
     frames = np.linspace(0.0, t_end, 11)[1:]
     writers = ([DynamicRunWriter(folder, bodies.system, layout=bodies.layout, frame_times=frames)]
                if folder else [])  # fmt: skip
@@ -148,7 +169,7 @@ def _time_loop(inputs: ResolvedInputs, bodies: ImpactBodies, recorder: ImpactRec
     # an adaptive patch rebuilds the problem (its body's patch), not only the system
     res = solve(bodies.system if adapt is None else bodies.problem, integrator, t_end=t_end,
                 v0=bodies.initial_velocity(inputs.velocity), constraints=[bodies.contact],
-                on_step=[recorder], on_record=writers, t_eval=frames, adapt=adapt,
+                on_step=listeners, on_record=writers, t_eval=frames, adapt=adapt,
                 **options)  # fmt: skip
     return res, time.perf_counter() - tic
 

@@ -231,16 +231,20 @@ class ImpactBodies:
         self.slow_blocks = tuple(b for b in ("ball.coarse", "block.coarse")
                                  if model == "arlequin" and b in blocks)  # fmt: skip
 
-    def _bind(self, problem: MultiBodyProblem) -> None:
+    def _bind(self, problem: MultiBodyProblem, system: Any = None, contact: Any = None) -> None:
         """The system, layout, contact and measures of ``problem`` (this set-up's, or the one
-        an adaptive block patch grew to)."""
+        an adaptive block patch grew to: its ``system`` and ``contact`` already built)."""
         self.problem = problem
-        self.system = problem.system()
+        # an assembled system caches its blocks' mass: the integrator's is reused
+        self.system = problem.system() if system is None else system
         self.layout = problem.field_layout()
         for name, body in problem.bodies.items():
             if isinstance(body, ArlequinProblem) and body.patches:
                 self.meshes[f"{name}.patch"] = body.patches[0].model.mesh
-        self.contact = self.contact_for(problem)
+        if contact is None:
+            self.contact = self.contact_for(problem)
+        else:
+            self.contact, self.pair = contact, contact.pair
         dm = self.system.dofmap
         self._ball_z = np.concatenate([dm[b].component_dofs(1) for b in dm
                                        if b.startswith("ball.")])  # fmt: skip
@@ -290,9 +294,10 @@ class ImpactBodies:
                                   name="contact")  # fmt: skip
         return LevelSetContact(pair, material=self._ball_material, name="contact")
 
-    def regrow(self, problem: MultiBodyProblem) -> None:
-        """Follow an adaptive block patch that grew: ``problem`` is the new set-up."""
-        self._bind(problem)
+    def regrow(self, problem: MultiBodyProblem, system: Any = None, contact: Any = None) -> None:
+        """Follow an adaptive block patch that grew: ``problem`` is the new set-up, ``system``
+        and ``contact`` (:meth:`contact_for`) those the run already built on it, if given."""
+        self._bind(problem, system, contact)
 
     def adaptation(self, threshold: float, buffer: int, every: int, max_fraction: float) -> Any:
         """The adaptive block patch (:class:`~arlequin.problem.adapt_bodies.BodyAdaptation`
