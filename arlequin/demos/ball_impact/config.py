@@ -22,7 +22,16 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 from ...models import IsotropicElastic, J2Material
-from ..config import DemoConfig, _plain, check_choice, check_range, option
+from ..adaptive_options import (
+    adapt_buffer_option,
+    adapt_every_option,
+    adapt_threshold_option,
+    adaptive_inputs,
+    adaptive_option,
+    check_adaptive_options,
+    max_patch_fraction_option,
+)
+from ..config import DemoConfig, _plain, check_choice, option
 from .result import INPUT_UNITS, BallImpactResult, hertz
 from .setup import BallSizes, ResolvedInputs, ball_sizes, mono_cells
 
@@ -212,20 +221,14 @@ class BallImpactConfig(DemoConfig):
         metavar="T",
         default_help="1.4 x Hertz's contact duration (elastic), 1.5 pi sqrt(m/k) (plastic)",
     )
-    adaptive: bool = option(
-        False, "adaptive block patch (--regime plastic): a seed of radius --patch-size at the "
-        "contact that grows where the block nears yield", "",
-    )  # fmt: skip
-    adapt_threshold: float = option(0.8, "coarse cells whose von Mises stress reaches BETA σy "
-                                    "join the patch", "1", metavar="BETA")  # fmt: skip
-    adapt_buffer: int = option(1, "rings of coarse cells added around the flagged ones", "1",
-                               metavar="RINGS")  # fmt: skip
-    adapt_every: int = option(50, "evaluate the indicator (and the yield check) every N time "
-                              "steps", "1", metavar="N")  # fmt: skip
-    max_patch_fraction: float = option(
-        0.5, "largest share of the block the adaptive patch may cover (beyond: the run stops)",
-        "1", metavar="F",
-    )  # fmt: skip
+    adaptive: bool = adaptive_option(
+        "(--regime plastic) a block patch seeded with radius --patch-size at the contact that "
+        "grows where the block nears yield"
+    )
+    adapt_threshold: float = adapt_threshold_option(0.8)
+    adapt_buffer: int = adapt_buffer_option()
+    adapt_every: int = adapt_every_option(50, "(and the yield check) every N time steps")
+    max_patch_fraction: float = max_patch_fraction_option(0.5, "block")
     ball_material: IsotropicElastic | None = option(  # noqa: RUF009 (frozen materials)
         None, "the ball's material (default steel)", "", cli=False
     )
@@ -277,13 +280,7 @@ class BallImpactConfig(DemoConfig):
 
     def _check_adaptive(self) -> dict[str, Any] | None:
         """The adaptive options checked; their values (None without ``adaptive``)."""
-        check_range("adapt_threshold", self.adapt_threshold, 0.0, 1.0, closed="(]")
-        for name in ("adapt_buffer", "adapt_every"):
-            value, low = getattr(self, name), 1 if name == "adapt_every" else 0
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or \
-                    int(value) != value or value < low:  # fmt: skip
-                raise ValueError(f"{name} must be an integer >= {low}, got {name}={value!r}")
-        check_range("max_patch_fraction", self.max_patch_fraction, 0.0, 1.0, closed="(]")
+        check_adaptive_options(self)
         if not self.adaptive:
             return None
         if self.model != "arlequin" or self.regime != "plastic" or self.rigid_wall:
@@ -297,9 +294,7 @@ class BallImpactConfig(DemoConfig):
 
     def _adapt_values(self) -> dict[str, Any]:
         """The adaptive options as recorded (with or without ``adaptive``)."""
-        return {"adapt_threshold": float(self.adapt_threshold),
-                "adapt_buffer": int(self.adapt_buffer), "adapt_every": int(self.adapt_every),
-                "max_patch_fraction": float(self.max_patch_fraction)}  # fmt: skip
+        return adaptive_inputs(self)
 
     def _materials(self) -> tuple[IsotropicElastic, IsotropicElastic | J2Material]:
         """The ball's and the block's materials: the given (or default) ones with the given

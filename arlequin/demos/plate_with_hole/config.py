@@ -6,6 +6,14 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
+from ..adaptive_options import (
+    adapt_buffer_option,
+    adapt_every_option,
+    adapt_threshold_option,
+    adaptive_option,
+    check_adaptive_options,
+    max_patch_fraction_option,
+)
 from ..config import DemoConfig, check_choice, check_positive, check_range, option
 
 __all__ = ["BLOCK", "DEFAULT_LOAD", "MATERIALS", "MAX_LEVELS", "MODELS", "PlateWithHoleConfig"]
@@ -85,22 +93,16 @@ class PlateWithHoleConfig(DemoConfig):
         None, "the patch: the coarse cells within the square [0, RP]^2 (RP snapped down to a "
         "grid line)", "m", metavar="RP", default_help="3.5a",
     )  # fmt: skip
-    adaptive: bool = option(
-        False, "adaptive patch: a seed of the coarse ring at the hole that grows where the "
-        "material nears yield (--model arlequin)", "",
-    )  # fmt: skip
+    adaptive: bool = adaptive_option(
+        "a seed of the coarse ring at the hole that grows where the material nears yield "
+        "(--model arlequin)"
+    )
     # 0.9, not the library's 0.8: at the default load the elastic ligament above the hole
     # carries 0.8 σy (net section, plane strain), and β = 0.8 grows the patch along all of it
-    adapt_threshold: float = option(0.9, "coarse cells whose von Mises stress reaches BETA σy "
-                                    "join the patch", "1", metavar="BETA")  # fmt: skip
-    adapt_buffer: int = option(1, "rings of coarse cells added around the flagged ones", "1",
-                               metavar="RINGS")  # fmt: skip
-    adapt_every: int = option(1, "evaluate the indicator every N load steps (the yield check "
-                              "every step)", "1", metavar="N")  # fmt: skip
-    max_patch_fraction: float = option(
-        0.5, "largest share of the plate the adaptive patch may cover (beyond: the run stops)",
-        "1", metavar="F",
-    )  # fmt: skip
+    adapt_threshold: float = adapt_threshold_option(0.9)
+    adapt_buffer: int = adapt_buffer_option()
+    adapt_every: int = adapt_every_option(1, "every N load steps (the yield check every step)")
+    max_patch_fraction: float = max_patch_fraction_option(0.5, "plate")
 
     # -- resolved values ---------------------------------------------------------------------
     @property
@@ -156,10 +158,7 @@ class PlateWithHoleConfig(DemoConfig):
                 )
 
     def _check_adaptive(self) -> None:
-        check_range("adapt_threshold", self.adapt_threshold, 0.0, 1.0, closed="(]")
-        _count("adapt_buffer", self.adapt_buffer, 0)
-        _count("adapt_every", self.adapt_every, 1)
-        check_range("max_patch_fraction", self.max_patch_fraction, 0.0, 1.0, closed="(]")
+        check_adaptive_options(self)
         if self.adaptive and self.model != "arlequin":
             raise ValueError(f"adaptive needs model='arlequin', got model={self.model!r}")
         if self.adaptive and self.patch_radius is not None:

@@ -7,6 +7,14 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
+from ..adaptive_options import (
+    adapt_buffer_option,
+    adapt_every_option,
+    adapt_threshold_option,
+    adaptive_option,
+    check_adaptive_options,
+    max_patch_fraction_option,
+)
 from ..config import DemoConfig, check_choice, check_positive, check_range, option
 
 __all__ = ["MATERIALS", "MODELS", "SHAPES", "PressureVesselConfig"]
@@ -77,20 +85,14 @@ class PressureVesselConfig(DemoConfig):
                                      default_help="(b - a)/64")  # fmt: skip
     coarse_size: float | None = option(None, "radial size of the coarse cells", "m",
                                        metavar="H", default_help="(b - a)/8")  # fmt: skip
-    adaptive: bool = option(
-        False, "adaptive patch: a seed of one coarse ring at the bore that grows where the "
-        "material nears yield (--model arlequin)", "",
-    )  # fmt: skip
-    adapt_threshold: float = option(0.8, "coarse cells whose von Mises stress reaches BETA σy "
-                                    "join the patch", "1", metavar="BETA")  # fmt: skip
-    adapt_buffer: int = option(1, "rings of coarse cells added around the flagged ones", "1",
-                               metavar="RINGS")  # fmt: skip
-    adapt_every: int = option(1, "evaluate the indicator every N load steps (the yield check "
-                              "every step)", "1", metavar="N")  # fmt: skip
-    max_patch_fraction: float = option(
-        0.95, "largest share of the wall the adaptive patch may cover (beyond: the run stops)",
-        "1", metavar="F",
-    )  # fmt: skip
+    adaptive: bool = adaptive_option(
+        "a seed of one coarse ring at the bore that grows where the material nears yield "
+        "(--model arlequin)"
+    )
+    adapt_threshold: float = adapt_threshold_option(0.8)
+    adapt_buffer: int = adapt_buffer_option()
+    adapt_every: int = adapt_every_option(1, "every N load steps (the yield check every step)")
+    max_patch_fraction: float = max_patch_fraction_option(0.95, "wall")
 
     # -- resolved values ---------------------------------------------------------------------
     @property
@@ -178,12 +180,7 @@ class PressureVesselConfig(DemoConfig):
         self._check_adaptive()
 
     def _check_adaptive(self) -> None:
-        check_range("adapt_threshold", self.adapt_threshold, 0.0, 1.0, closed="(]")
-        for name in ("adapt_buffer", "adapt_every"):
-            value, low = getattr(self, name), 1 if name == "adapt_every" else 0
-            if isinstance(value, bool) or int(value) != value or value < low:
-                raise ValueError(f"{name} must be an integer >= {low}, got {name}={value!r}")
-        check_range("max_patch_fraction", self.max_patch_fraction, 0.0, 1.0, closed="(]")
+        check_adaptive_options(self)
         if self.adaptive and self.model != "arlequin":
             raise ValueError(f"adaptive needs model='arlequin', got model={self.model!r}")
         if self.adaptive and self.patch_outer is not None:
