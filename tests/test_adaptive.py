@@ -157,6 +157,58 @@ def test_an_indicator_of_the_wrong_shape_is_refused():
         solve_quasi_static(problem, steps=2, adapt=adapt)
 
 
+def test_an_indicator_of_non_boolean_flags_is_refused():
+    """0.5 everywhere is not a flag: it would have grown every cell."""
+    problem, mesh = _problem(2, ((1.6, 0.6), (2.4, 1.4)))
+    adapt = AdaptivePatch(indicator=lambda view: np.full(mesh.nelements, 0.5))
+    with pytest.raises(IndicatorError, match="boolean"):
+        solve_quasi_static(problem, steps=2, adapt=adapt)
+
+
+@pytest.mark.parametrize("value", [np.float32(0.8), np.float64(0.5), 1])
+def test_a_threshold_given_as_any_real_number_is_taken(value):
+    assert AdaptivePatch(threshold=value).threshold == pytest.approx(float(value))
+
+
+@pytest.mark.parametrize(("option", "value"), [("max_fraction", "0.5"), ("max_fraction", None),
+                                               ("threshold", "0.8")])  # fmt: skip
+def test_options_of_the_wrong_type_are_named(option, value):
+    with pytest.raises(ValueError, match=option):
+        AdaptivePatch(**{option: value})
+
+
+def test_adapt_that_is_not_an_adaptive_patch_is_named():
+    problem, _ = _problem(2, ((1.6, 0.6), (2.4, 1.4)))
+    with pytest.raises(ValueError, match="adapt must be an AdaptivePatch, got float"):
+        solve_quasi_static(problem, steps=2, adapt=0.8)
+
+
+def test_a_cap_below_the_seed_is_refused_before_any_step():
+    """The seed (2 × 2 of the 8 × 4 coarse cells: 0.125 of the mesh) over a cap of 0.1."""
+    problem, _ = _problem(2, ((1.6, 0.6), (2.4, 1.4)))
+    seen = []
+    with pytest.raises(ValueError, match=r"max_fraction=0\.1 is below .* \(0\.125\)"):
+        solve_quasi_static(problem, steps=2, adapt=AdaptivePatch(max_fraction=0.1),
+                           on_step=[lambda s: seen.append(s.t)])  # fmt: skip
+    assert seen == []
+
+
+def test_an_adaptive_patch_used_again_starts_afresh():
+    """A second run with the same object reports its own growths, not the first run's too."""
+    first, mesh = _problem(2, ((1.6, 0.6), (2.4, 1.4)))
+    adapt = AdaptivePatch(indicator=_grow_twice(mesh, 2), buffer=0)
+    one = solve_quasi_static(first, steps=3, adapt=adapt)
+    n_first = len(one.adaptations)
+    second, _ = _problem(2, ((1.6, 0.6), (2.4, 1.4)))
+    never = AdaptivePatch(indicator=lambda view: np.zeros(mesh.nelements, dtype=bool))
+    fresh = solve_quasi_static(second, steps=3, adapt=never)
+    adapt.indicator = never.indicator
+    again = solve_quasi_static(_problem(2, ((1.6, 0.6), (2.4, 1.4)))[0], steps=3, adapt=adapt)
+    assert n_first == 2 and len(one.adaptations) == 2  # the first result keeps its own
+    assert again.adaptations == [] == fresh.adaptations
+    assert again.max_coarse_yield_ratio == pytest.approx(fresh.max_coarse_yield_ratio)
+
+
 # -- the pressure sphere, adaptive (arlequin pressure-vessel --adaptive) -----------------------
 SMALL = {"coarse_size": 0.025, "fine_size": 0.025 / 4, "pressure": 2e8, "steps": 5}
 

@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import logging
 import math
+import numbers
 import time
 import warnings
 from collections.abc import Callable
@@ -195,6 +196,11 @@ class Growth:
     reject: bool
 
 
+def _is_real(value: Any) -> bool:
+    """A real number (numpy scalars included), not a bool."""
+    return isinstance(value, numbers.Real) and not isinstance(value, bool)
+
+
 def cell_rings(mesh: Any, mask: np.ndarray, rings: int) -> np.ndarray:
     """``mask`` of cells grown by ``rings`` layers of cells sharing a node with it."""
     out = mask.copy()
@@ -286,20 +292,20 @@ class AdaptivePatch:
         interval: float | None = None,
         band_weight: float = 0.0,
     ) -> None:
-        if not (isinstance(threshold, (int, float)) and 0.0 < threshold <= 1.0):
+        if not (_is_real(threshold) and 0.0 < threshold <= 1.0):
             raise ValueError(f"threshold β must lie in (0, 1], got threshold={threshold!r}")
         for name, value, low in (("buffer", buffer, 0), ("band_cells", band_cells, 0),
                                  ("every", every, 1), ("patch", patch, 0)):  # fmt: skip
             if isinstance(value, bool) or int(value) != value or value < low:
                 raise ValueError(f"{name} must be an integer >= {low}, got {name}={value!r}")
         if interval is not None and not (
-            isinstance(interval, (int, float)) and math.isfinite(interval) and interval > 0.0
+            _is_real(interval) and math.isfinite(interval) and interval > 0.0
         ):
             raise ValueError(f"interval must be a positive time (s), got interval={interval!r}")
         self.interval = None if interval is None else float(interval)
-        if not (0.0 < max_fraction <= 1.0):
-            raise ValueError(f"max_fraction must lie in (0, 1], got max_fraction={max_fraction}")
-        if not (isinstance(band_weight, (int, float)) and 0.0 <= band_weight < 1.0):
+        if not (_is_real(max_fraction) and 0.0 < max_fraction <= 1.0):
+            raise ValueError(f"max_fraction must lie in (0, 1], got max_fraction={max_fraction!r}")
+        if not (_is_real(band_weight) and 0.0 <= band_weight < 1.0):
             raise ValueError(f"band_weight must lie in [0, 1), got band_weight={band_weight!r}")
         if levels is not None and (int(levels) != levels or levels < 0):
             raise ValueError(f"levels must be a non-negative integer, got levels={levels}")
@@ -340,6 +346,9 @@ class AdaptivePatch:
         if not coarse.is_linear or not callable(getattr(coarse, "stress_at_quadrature", None)):
             raise ValueError("adaptation needs a linear coarse model with stress_at_quadrature(u)")
         self.problem = problem
+        # a new run: the growths and the coarse yield ratio of an earlier run with this object
+        # are not this one's (a new list: the earlier result keeps its own)
+        self.records, self.max_coarse_yield_ratio = [], 0.0
         pc = problem.couplings[self.index]
         if pc.overlap.method != "nested":
             raise NonNestedPatchError(
@@ -367,6 +376,11 @@ class AdaptivePatch:
             self.model_factory = model.with_mesh
         self._check_refine(model.mesh)
         self._measure = _plane_measures(coarse.mesh)
+        if self.patch_fraction > self.max_fraction:
+            raise ValueError(
+                f"max_fraction={self.max_fraction} is below the share of the coarse mesh the "
+                f"patch {self.name} covers from the start ({self.patch_fraction:.4g})"
+            )
         return problem
 
     def _check_refine(self, mesh: Any) -> None:
@@ -430,10 +444,11 @@ class AdaptivePatch:
         n = outside.size
         if self.indicator is not None:
             flags = np.asarray(self.indicator(view))
-            if flags.shape != (n,):
-                raise IndicatorError(f"the indicator must return one flag per coarse cell, shape "
-                                     f"({n},), got shape {flags.shape}")  # fmt: skip
-            return flags.astype(bool)
+            if flags.shape != (n,) or flags.dtype != bool:
+                raise IndicatorError(f"the indicator must return one boolean flag per coarse "
+                                     f"cell, shape ({n},), got shape {flags.shape} of "
+                                     f"{flags.dtype}")  # fmt: skip
+            return flags
         return (outside & (ratio >= self.threshold)) | band_flags
 
     def _band_flags(self, view: AdaptView, outside: np.ndarray) -> tuple[np.ndarray, bool]:
@@ -484,8 +499,12 @@ class AdaptivePatch:
         if fraction > self.max_fraction * (1.0 + 1e-12):
             raise PatchLimitError(
                 f"the patch {self.name} would cover {fraction:.3f} of the coarse mesh after step "
-                f"{step}, beyond max_fraction={self.max_fraction}: the run stops (the coarse "
-                "model would carry plastic flow)",
+                f"{step}, beyond max_fraction={self.max_fraction}: the run stops ("
+                + (
+                    "the coarse model would carry plastic flow)"
+                    if growth.reject
+                    else "the material nears yield beyond the patch)"
+                ),
                 step=step,
                 time=time_,
             )

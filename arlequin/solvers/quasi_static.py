@@ -567,6 +567,8 @@ def solve_quasi_static(
         Bad input (named), before any work.
     """
     if adapt is not None:
+        if not callable(getattr(adapt, "bind", None)):
+            raise ValueError(f"adapt must be an AdaptivePatch, got {type(adapt).__name__}")
         problem = adapt.bind(problem)
     solver = QuasiStaticSolver(problem, load=load, steps=steps, **options)
     if adapt is not None:
