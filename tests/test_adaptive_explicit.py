@@ -212,6 +212,62 @@ def test_explicit_interval_above_yield_is_computed_again():
         assert a.step % 50 == 0
 
 
+class _Steps:
+    """A listener keeping every step's time and displacement norm, rewound with the run."""
+
+    def __init__(self):
+        self.times, self.norms, self.rewinds = [], [], 0
+
+    def __call__(self, integ) -> None:
+        self.times.append(integ.t)
+        self.norms.append(float(np.linalg.norm(integ.u)))
+
+    def on_rewind(self, integ) -> None:
+        self.rewinds += 1
+        keep = int(np.searchsorted(self.times, integ.t, side="right"))
+        del self.times[keep:], self.norms[keep:]
+
+
+def test_explicit_rejected_interval_rewinds_the_listeners(tmp_path):
+    """The set-up of the previous test (three rejected intervals, measured): the listeners are
+    told of each (``on_rewind``) before the growth, so that after the run a per-step listener's
+    records and a results folder's history and frames are the committed trajectory's, the same
+    as the solver's result (no time twice, times increasing)."""
+    from arlequin.io import DynamicRunWriter, ResultsFolder, read_history, read_series
+
+    problem, _ = _bar(SEED, 16, sigma_y=4e7, traction=False)
+    _, _, mode = _struck()
+    adapt = AdaptivePatch(threshold=0.8, buffer=1, every=50, max_fraction=1.0)
+    steps = _Steps()
+    folder = ResultsFolder(tmp_path, "test", {})
+    frames = np.linspace(0.0, 300 * 2.2e-5, 31)[1:]  # every ~10 steps (dt ≈ 1.9e-5 s measured)
+    writer = DynamicRunWriter(folder, problem.system(), layout=problem.field_layout(),
+                              frame_times=frames)  # fmt: skip
+    res = arlequin.solve(problem, "explicit", n_steps=300, v0=_nodal(problem, mode), adapt=adapt,
+                         on_step=[steps], on_record=[writer])  # fmt: skip
+    folder.finish()
+    n_rejected = sum(a.rejected for a in res.adaptations)
+    assert n_rejected >= 1 and steps.rewinds == n_rejected
+    # the per-step listener: steps 1 to 300 of the committed run, the result's records
+    assert len(steps.times) == 300 and np.all(np.diff(steps.times) > 0)
+    np.testing.assert_array_equal(steps.times, res.times[1:])
+    # the history file: one row per record of the result
+    history = read_history(tmp_path / "history.csv")
+    np.testing.assert_array_equal(history["t"], res.times)
+    np.testing.assert_array_equal(history["step"], np.arange(301))
+    # the frames of every series of the patch and the coarse model: each frame time once, in
+    # order, and the frames of the coarse series at the first record at or after each time
+    written = []
+    for path in sorted((tmp_path / "fields").glob("patch0*.xdmf")):
+        written += [t for t, _, _ in read_series(path)[1]]
+    assert np.all(np.diff(written) > 0)
+    coarse = [t for t, _, _ in read_series(tmp_path / "fields" / "coarse.xdmf")[1]]
+    times = np.asarray(res.times)
+    expected = [times[np.searchsorted(times, f * (1 - 1e-12))] for f in frames if f <= times[-1]]
+    np.testing.assert_array_equal(coarse, np.unique(expected))
+    assert writer.frames_written == coarse
+
+
 def test_explicit_checks_every_interval_of_simulated_time():
     """``interval`` (s) instead of ``every``: with a fixed step, checks every 50 steps' time,
     the growth at the same step as with ``every=50``."""
