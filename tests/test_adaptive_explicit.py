@@ -500,3 +500,30 @@ def test_ball_impact_adaptive_pictures_and_patch_history_on_disk(tmp_path):
     for g in growths:  # the explicit growths' timers, as the quasi-static ones
         assert g.wall_time_s > 0.0 and g.system_time_s > 0.0 and g.resolve_time_s > 0.0
         assert g.discarded_time_s == 0.0 and not g.rejected
+
+
+def test_ball_impact_adaptive_rejected_interval_leaves_no_discarded_rows(tmp_path):
+    """The coarser set-up of ``benchmarks/adaptive.py --case ball --size quick`` (coarse π R/32,
+    seed 0.45 R, 3 m/s), checked every 400 steps at β = 1: the interval from step 400 to 800
+    is rejected (measured) and computed again on the grown patch. ``impact.csv`` and the
+    result's history then hold the committed rows only: every row after a growth carries the
+    patch's share after it (without the rewind, 199 rows of the discarded interval kept the
+    share before it, and the peak force was the discarded interval's, 4759.6 N against the
+    committed 4744.9 N, measured)."""
+    from arlequin.demos.ball_impact import run_ball_impact
+    from arlequin.io import read_history
+
+    quick = {"regime": "plastic", "block_radius": 0.02, "block_height": 0.02,
+             "coarse_size": 0.25 * np.pi * 0.01 / 8, "velocity": 3.0,
+             "patch_size": 0.0045}  # fmt: skip
+    res = run_ball_impact(adaptive=True, adapt_every=400, adapt_threshold=1.0, out=tmp_path,
+                          **quick)  # fmt: skip
+    assert any(a["rejected"] for a in res.adaptations)
+    rows = read_history(tmp_path / "impact.csv")
+    t, share = np.asarray(rows["t"]), np.asarray(rows["patch_fraction"])
+    assert np.all(np.diff(t) > 0)
+    np.testing.assert_array_equal(t, res.history["t"])
+    np.testing.assert_array_equal(rows["contact_force"], res.history["contact_force"])
+    for a in res.adaptations:
+        assert np.all(share[t > a["time"]] >= a["patch_fraction"])
+    assert res.peak_force >= max(rows["contact_force"])
