@@ -381,6 +381,20 @@ def test_explicit_adaptation_of_one_body_of_a_multi_body_problem():
     n = alone.u.size  # body "a" first: the same steps as alone, to round-off
     for got, ref in ((res.u[:n], alone.u), (res.v[:n], alone.v)):
         assert np.abs(got - ref).max() <= 1e-10 * np.abs(ref).max()
+    # the growth kept body "a"'s system: its operators and its own critical step computed
+    # once (the same objects in the grown problem's system), those of "b" computed again
+    before, after = bodies.system(), res.problem.system()
+    assert res.problem.body_systems()["a"] is bodies.body_systems()["a"]
+    for name in ("a.coarse", "a.patch0"):
+        assert after.block_stiffness(after.block(name)) is before.block_stiffness(
+            before.block(name))  # fmt: skip
+        assert after.block_mass(after.block(name)) is before.block_mass(before.block(name))
+    assert after.block_mass(after.block("b.coarse")) is not before.block_mass(
+        before.block("b.coarse"))  # fmt: skip
+    fresh = MultiBodyProblem(dict(res.problem.bodies)).system()
+    for b in after.blocks:  # what is shared is what would be computed
+        diff = after.block_stiffness(b) - fresh.block_stiffness(fresh.block(b.name))
+        assert abs(diff).max() == 0.0
 
 
 # -- the ball impact, adaptive (arlequin ball-impact --regime plastic --adaptive) --------------
