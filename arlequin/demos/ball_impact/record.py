@@ -7,7 +7,8 @@ ball's mean velocity, the energies: kinetic, elastic, plastic dissipation, conta
 works; with an adaptive block patch, its share of the block's area), written to ``impact.csv``
 as the run goes when a results folder is open. The energies cost a product with every linear
 stiffness, and the J2 model's stored energy 3.6 of its internal-force evaluations (measured),
-hence the samples. SI units.
+hence the samples. An adaptive run's rejected interval (``on_rewind``) drops the steps, samples
+and ``impact.csv`` rows taken after the committed time. SI units.
 """
 
 from __future__ import annotations
