@@ -212,6 +212,62 @@ def test_explicit_interval_above_yield_is_computed_again():
         assert a.step % 50 == 0
 
 
+class _Steps:
+    """A listener keeping every step's time and displacement norm, rewound with the run."""
+
+    def __init__(self):
+        self.times, self.norms, self.rewinds = [], [], 0
+
+    def __call__(self, integ) -> None:
+        self.times.append(integ.t)
+        self.norms.append(float(np.linalg.norm(integ.u)))
+
+    def on_rewind(self, integ) -> None:
+        self.rewinds += 1
+        keep = int(np.searchsorted(self.times, integ.t, side="right"))
+        del self.times[keep:], self.norms[keep:]
+
+
+def test_explicit_rejected_interval_rewinds_the_listeners(tmp_path):
+    """The set-up of the previous test (three rejected intervals, measured): the listeners are
+    told of each (``on_rewind``) before the growth, so that after the run a per-step listener's
+    records and a results folder's history and frames are the committed trajectory's, the same
+    as the solver's result (no time twice, times increasing)."""
+    from arlequin.io import DynamicRunWriter, ResultsFolder, read_history, read_series
+
+    problem, _ = _bar(SEED, 16, sigma_y=4e7, traction=False)
+    _, _, mode = _struck()
+    adapt = AdaptivePatch(threshold=0.8, buffer=1, every=50, max_fraction=1.0)
+    steps = _Steps()
+    folder = ResultsFolder(tmp_path, "test", {})
+    frames = np.linspace(0.0, 300 * 2.2e-5, 31)[1:]  # every ~10 steps (dt ≈ 1.9e-5 s measured)
+    writer = DynamicRunWriter(folder, problem.system(), layout=problem.field_layout(),
+                              frame_times=frames)  # fmt: skip
+    res = arlequin.solve(problem, "explicit", n_steps=300, v0=_nodal(problem, mode), adapt=adapt,
+                         on_step=[steps], on_record=[writer])  # fmt: skip
+    folder.finish()
+    n_rejected = sum(a.rejected for a in res.adaptations)
+    assert n_rejected >= 1 and steps.rewinds == n_rejected
+    # the per-step listener: steps 1 to 300 of the committed run, the result's records
+    assert len(steps.times) == 300 and np.all(np.diff(steps.times) > 0)
+    np.testing.assert_array_equal(steps.times, res.times[1:])
+    # the history file: one row per record of the result
+    history = read_history(tmp_path / "history.csv")
+    np.testing.assert_array_equal(history["t"], res.times)
+    np.testing.assert_array_equal(history["step"], np.arange(301))
+    # the frames of every series of the patch and the coarse model: each frame time once, in
+    # order, and the frames of the coarse series at the first record at or after each time
+    written = []
+    for path in sorted((tmp_path / "fields").glob("patch0*.xdmf")):
+        written += [t for t, _, _ in read_series(path)[1]]
+    assert np.all(np.diff(written) > 0)
+    coarse = [t for t, _, _ in read_series(tmp_path / "fields" / "coarse.xdmf")[1]]
+    times = np.asarray(res.times)
+    expected = [times[np.searchsorted(times, f * (1 - 1e-12))] for f in frames if f <= times[-1]]
+    np.testing.assert_array_equal(coarse, np.unique(expected))
+    assert writer.frames_written == coarse
+
+
 def test_explicit_checks_every_interval_of_simulated_time():
     """``interval`` (s) instead of ``every``: with a fixed step, checks every 50 steps' time,
     the growth at the same step as with ``every=50``."""
@@ -325,6 +381,20 @@ def test_explicit_adaptation_of_one_body_of_a_multi_body_problem():
     n = alone.u.size  # body "a" first: the same steps as alone, to round-off
     for got, ref in ((res.u[:n], alone.u), (res.v[:n], alone.v)):
         assert np.abs(got - ref).max() <= 1e-10 * np.abs(ref).max()
+    # the growth kept body "a"'s system: its operators and its own critical step computed
+    # once (the same objects in the grown problem's system), those of "b" computed again
+    before, after = bodies.system(), res.problem.system()
+    assert res.problem.body_systems()["a"] is bodies.body_systems()["a"]
+    for name in ("a.coarse", "a.patch0"):
+        assert after.block_stiffness(after.block(name)) is before.block_stiffness(
+            before.block(name))  # fmt: skip
+        assert after.block_mass(after.block(name)) is before.block_mass(before.block(name))
+    assert after.block_mass(after.block("b.coarse")) is not before.block_mass(
+        before.block("b.coarse"))  # fmt: skip
+    fresh = MultiBodyProblem(dict(res.problem.bodies)).system()
+    for b in after.blocks:  # what is shared is what would be computed
+        diff = after.block_stiffness(b) - fresh.block_stiffness(fresh.block(b.name))
+        assert abs(diff).max() == 0.0
 
 
 # -- the ball impact, adaptive (arlequin ball-impact --regime plastic --adaptive) --------------
@@ -444,3 +514,30 @@ def test_ball_impact_adaptive_pictures_and_patch_history_on_disk(tmp_path):
     for g in growths:  # the explicit growths' timers, as the quasi-static ones
         assert g.wall_time_s > 0.0 and g.system_time_s > 0.0 and g.resolve_time_s > 0.0
         assert g.discarded_time_s == 0.0 and not g.rejected
+
+
+def test_ball_impact_adaptive_rejected_interval_leaves_no_discarded_rows(tmp_path):
+    """The coarser set-up of ``benchmarks/adaptive.py --case ball --size quick`` (coarse π R/32,
+    seed 0.45 R, 3 m/s), checked every 400 steps at β = 1: the interval from step 400 to 800
+    is rejected (measured) and computed again on the grown patch. ``impact.csv`` and the
+    result's history then hold the committed rows only: every row after a growth carries the
+    patch's share after it (without the rewind, 199 rows of the discarded interval kept the
+    share before it, and the peak force was the discarded interval's, 4759.6 N against the
+    committed 4744.9 N, measured)."""
+    from arlequin.demos.ball_impact import run_ball_impact
+    from arlequin.io import read_history
+
+    quick = {"regime": "plastic", "block_radius": 0.02, "block_height": 0.02,
+             "coarse_size": 0.25 * np.pi * 0.01 / 8, "velocity": 3.0,
+             "patch_size": 0.0045}  # fmt: skip
+    res = run_ball_impact(adaptive=True, adapt_every=400, adapt_threshold=1.0, out=tmp_path,
+                          **quick)  # fmt: skip
+    assert any(a["rejected"] for a in res.adaptations)
+    rows = read_history(tmp_path / "impact.csv")
+    t, share = np.asarray(rows["t"]), np.asarray(rows["patch_fraction"])
+    assert np.all(np.diff(t) > 0)
+    np.testing.assert_array_equal(t, res.history["t"])
+    np.testing.assert_array_equal(rows["contact_force"], res.history["contact_force"])
+    for a in res.adaptations:
+        assert np.all(share[t > a["time"]] >= a["patch_fraction"])
+    assert res.peak_force >= max(rows["contact_force"])

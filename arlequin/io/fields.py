@@ -91,6 +91,25 @@ class FieldSeries:
         self._writer.flush()
         self.times.append(float(t))
 
+    def drop_after(self, t: float) -> int:
+        """Remove the frames after time ``t`` (s) from the XDMF file and their data from the
+        HDF5 file (an adaptive run's rejected interval); the number of frames removed."""
+        writer = self._writer
+        keep = sum(1 for s in self.times if s <= t)
+        if writer is None or keep == len(self.times):
+            return 0
+        frames = [g for g in writer.collection.findall("Grid") if g.find("Time") is not None]
+        for grid in frames[keep:]:
+            for item in grid.iter("DataItem"):
+                name = (item.text or "").rpartition(":/")[2]
+                if name in writer.h5_file:
+                    del writer.h5_file[name]
+            writer.collection.remove(grid)
+        dropped = len(self.times) - keep
+        del self.times[keep:]
+        writer.flush()
+        return dropped
+
     def close(self) -> None:
         """Close the HDF5 file (the XML is already complete)."""
         if self._writer is not None:

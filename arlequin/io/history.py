@@ -38,12 +38,34 @@ class HistoryCSV:
         self._csv.writerow([f"{c} [{units[c]}]" if units.get(c) else c for c in self.columns])
         self._fh.flush()
         self.n_rows = 0
+        # the file's length after the header and after each row: where a truncation cuts
+        self._ends = [self._fh.tell()]
 
     def append(self, row: Mapping[str, float]) -> None:
         """Write one row (missing columns are left empty) and flush it to disk."""
         self._csv.writerow([_text(row[c]) if c in row else "" for c in self.columns])
         self._fh.flush()
         self.n_rows += 1
+        self._ends.append(self._fh.tell())
+
+    def truncate(self, n_rows: int) -> None:
+        """Keep the first ``n_rows`` rows on disk, drop the others (an adaptive run's rejected
+        interval: its rows are computed again).
+
+        Raises
+        ------
+        ValueError
+            If ``n_rows`` is negative or more than the rows written.
+        """
+        if not 0 <= n_rows <= self.n_rows:
+            raise ValueError(f"n_rows must be in [0, {self.n_rows}], got {n_rows}")
+        if n_rows == self.n_rows:
+            return
+        self._fh.seek(self._ends[n_rows])
+        self._fh.truncate()
+        self._fh.flush()
+        del self._ends[n_rows + 1 :]
+        self.n_rows = n_rows
 
     def close(self) -> None:
         """Close the file (every row is already on disk)."""

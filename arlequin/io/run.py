@@ -72,6 +72,10 @@ class DynamicRunWriter:
         self._next = 0
         self._e0: float | None = None
         self.frames_written: list[float] = []
+        # per history row: its time and how many frame times were consumed up to it (what an
+        # adaptive run's rejected interval rewinds to)
+        self._row_times: list[float] = []
+        self._row_next: list[int] = []
 
     def __call__(self, integ: Any) -> None:
         e = integ.energies()
@@ -88,6 +92,24 @@ class DynamicRunWriter:
         self.history.append(row)
         if self._due(integ.t, integ.step_size):
             self.write_frame(integ.t, integ.u, integ.v, integ.multipliers)
+        self._row_times.append(float(integ.t))
+        self._row_next.append(self._next)
+
+    def on_rewind(self, integ: Any) -> None:
+        """An interval of an adaptive run was rejected (``solve(..., adapt=)``), the integrator
+        is back at its committed state: the history rows and field frames after its time are
+        removed from the files, the frame times they consumed are due again."""
+        t = float(integ.t)
+        keep = int(np.searchsorted(self._row_times, t, side="right"))
+        self.history.truncate(keep)
+        del self._row_times[keep:]
+        del self._row_next[keep:]
+        self._next = self._row_next[-1] if keep else 0
+        if not keep:
+            self._e0 = None
+        for series in self.series.values():
+            series.drop_after(t)
+        self.frames_written = [s for s in self.frames_written if s <= t]
 
     def on_adapt(self, integ: Any, adapt: Any) -> None:
         """A patch grew (``solve(..., adapt=)``): the next rows and frames on the new system,

@@ -133,7 +133,7 @@ class BodyAdaptation:
         part = self._slice(old)
         inner, u_body, moved = self.adapt.grow(growth, u[part], self._body_states(states), step,
                                                time_)  # fmt: skip
-        new = MultiBodyProblem({**old.bodies, self.body: inner})
+        new = old.with_body(self.body, inner)  # the other bodies' systems kept
         self._last = part
         self.outer = new
         return new, self._splice(u, part, u_body), {self._key(k): v for k, v in moved.items()}

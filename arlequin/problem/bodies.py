@@ -105,10 +105,12 @@ class MultiBodyProblem:
 
     def body_systems(self) -> dict[str, CoupledSystem]:
         """Each body's own coupled system (built once)."""
-        if self._systems is None:
+        if self._systems is None or None in self._systems.values():
             out = {}
             for name, body in self.bodies.items():
-                if _is_problem(body):
+                if self._systems is not None and self._systems.get(name) is not None:
+                    out[name] = self._systems[name]
+                elif _is_problem(body):
                     out[name] = body.system()
                 else:
                     out[name] = CoupledSystem([Block("model", body, [BlockTerm(body)])])
@@ -150,7 +152,21 @@ class MultiBodyProblem:
                 f[off : off + s.n_dofs] = s.external_force(t)
             return f
 
-        return CoupledSystem(blocks, constraints, load if loaded else None)
+        out = CoupledSystem(blocks, constraints, load if loaded else None)
+        for b, s in systems.items():  # the operators computed once, on the body's system
+            for blk in s.blocks:
+                out.share_block(_join(b, blk.name), s, blk)
+        return out
+
+    def with_body(self, name: str, body: Any) -> MultiBodyProblem:
+        """The problem with body ``name`` replaced by ``body`` (its patch grown), the other
+        bodies' systems (and their operators, computed once) kept."""
+        if name not in self.bodies:
+            raise ValueError(f"unknown body {name!r}; bodies are {list(self.bodies)}")
+        new = MultiBodyProblem({**self.bodies, name: body})
+        kept = self.body_systems()
+        new._systems = {b: kept[b] if b != name else None for b in new.bodies}
+        return new
 
     def field_layout(self) -> FieldLayout:
         """Each body's fields (its problem's layout) under the assembled block names."""

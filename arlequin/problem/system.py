@@ -190,6 +190,29 @@ class CoupledSystem:
         for block in self.blocks:
             block.offset = self.dofmap[block.name].offset
         self._cache: dict[str, Any] = {}
+        # block name -> (system, its block) that owns the block's operators (a body's own
+        # system in a multi-body problem: kept when another body's patch grows, its operators
+        # with it)
+        self._sources: dict[str, tuple[CoupledSystem, Block]] = {}
+
+    def share_block(self, name: str, source: CoupledSystem, block: Block) -> None:
+        """Take block ``name``'s weighted operators (and :meth:`block_memo` values) from
+        ``source``'s ``block`` (the same terms), computed there once for every system that
+        shares it."""
+        self._sources[name] = (source, block)
+
+    def block_memo(self, block: Block, key: str, compute: Callable[[], Any]) -> Any:
+        """A value of one block that depends on its terms only (its stiffness, its mass, their
+        critical step...): ``compute()`` once per block and ``key``, shared with the systems the
+        block comes from (:meth:`share_block`)."""
+        full = f"{key}:{block.name}"
+        if full not in self._cache:
+            src = self._sources.get(block.name)
+            if src is not None:
+                self._cache[full] = src[0].block_memo(src[1], key, compute)
+            else:
+                self._cache[full] = compute()
+        return self._cache[full]
 
     @property
     def n_dofs(self) -> int:
@@ -209,21 +232,15 @@ class CoupledSystem:
     # ------------------------------------------------------------------ operators
     def block_stiffness(self, block: Block) -> sp.csr_matrix:
         """Weighted stiffness of one block (linear models), shape (n_b, n_b)."""
-        key = f"K:{block.name}"
-        if key not in self._cache:
-            self._cache[key] = sum(
-                (t.stiffness() for t in block.terms[1:]), block.terms[0].stiffness()
-            ).tocsr()
-        return self._cache[key]
+        return self.block_memo(block, "K", lambda: sum(
+            (t.stiffness() for t in block.terms[1:]), block.terms[0].stiffness()
+        ).tocsr())  # fmt: skip
 
     def block_mass(self, block: Block) -> sp.csr_matrix:
         """Weighted consistent mass of one block, shape (n_b, n_b)."""
-        key = f"M:{block.name}"
-        if key not in self._cache:
-            self._cache[key] = sum(
-                (t.mass() for t in block.terms[1:]), block.terms[0].mass()
-            ).tocsr()
-        return self._cache[key]
+        return self.block_memo(block, "M", lambda: sum(
+            (t.mass() for t in block.terms[1:]), block.terms[0].mass()
+        ).tocsr())  # fmt: skip
 
     def stiffness(self) -> sp.csr_matrix:
         """Block-diagonal weighted stiffness, shape (n, n) (N/m)."""

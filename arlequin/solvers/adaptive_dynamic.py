@@ -27,7 +27,11 @@ the time of its parts, as a quasi-static growth does (:class:`~arlequin.problem.
 ``resolve_time_s`` its first impulse from the moved fields (the multipliers re-solved) and the
 energies across the growth, ``discarded_time_s`` the rejected interval's steps);
 listeners with an ``on_adapt(integrator, adapt)`` member hear of it (after a rejected interval
-the integrator's time is the committed one, earlier than the last step they saw).
+the integrator's time is the committed one, earlier than the last step they saw). Before that,
+a rejected interval calls the ``on_rewind(integrator)`` member of the listeners that have one,
+the integrator back at the committed state: they drop what they took after ``integrator.t``
+(:class:`~arlequin.io.DynamicRunWriter` its history rows and field frames, on disk too), so that
+their records are the committed trajectory's.
 """
 
 from __future__ import annotations
@@ -80,12 +84,16 @@ class DynamicAdapter:
         problem at time ``t0`` (s), its stop times set.
     listeners : sequence
         The run's listeners; those with an ``on_adapt(integrator, adapt)`` member are told of
-        each growth.
+        each growth, those with an ``on_rewind(integrator)`` member of each rejected interval
+        (the integrator back at the committed state, before the growth: they drop what they
+        recorded after its time ``integrator.t``).
     """
 
     def __init__(self, adapt: Any, build: Callable[..., Any], listeners: Sequence[Any]) -> None:
         self.adapt, self.build = adapt, build
         self.listeners = [h for h in (getattr(x, "on_adapt", None) for x in listeners)
+                          if callable(h)]  # fmt: skip
+        self.rewinders = [h for h in (getattr(x, "on_rewind", None) for x in listeners)
                           if callable(h)]  # fmt: skip
         self.every = int(adapt.every)
         self.interval = getattr(adapt, "interval", None)
@@ -161,6 +169,9 @@ class DynamicAdapter:
         loop.pending = None if pending is None else list(pending)
         loop.integ = rec.integ = integ
         logger.info("interval rejected: back to t = %.6e s (step %d)", integ.t, integ.step_count)
+        # before the growth: the listeners forget what they took after the committed time
+        for hook in self.rewinders:
+            hook(integ)
         return integ
 
     # -- the growth -----------------------------------------------------------------------

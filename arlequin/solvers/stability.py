@@ -163,9 +163,18 @@ def stable_time_step(
     a = _scaled(ops.initial_stiffness(), m)
     per_block: dict[str, float] = {}
     lam_blocks = []
+    memo = getattr(system, "block_memo", None)
     for b in ops.blocks:
-        ab = a[b.dofs][:, b.dofs].tocsr()
-        lam_b = _gershgorin(ab) if method == "gershgorin" else largest_eigenvalue(ab, b.n_dofs, tol)
+
+        def block_lam(b=b) -> float:
+            ab = a[b.dofs][:, b.dofs].tocsr()
+            if method == "gershgorin":
+                return _gershgorin(ab)
+            return largest_eigenvalue(ab, b.n_dofs, tol)
+
+        # a block's own estimate depends on its terms only (its stiffness and lumped mass):
+        # computed once for the systems that share it (a body kept when another body grows)
+        lam_b = block_lam() if memo is None else memo(b, f"lam:{method}:{tol!r}", block_lam)
         lam_blocks.append(lam_b)
         per_block[b.name] = _dt(lam_b)
     block_bound = min(per_block.values()) if per_block else math.inf

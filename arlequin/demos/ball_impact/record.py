@@ -7,7 +7,8 @@ ball's mean velocity, the energies: kinetic, elastic, plastic dissipation, conta
 works; with an adaptive block patch, its share of the block's area), written to ``impact.csv``
 as the run goes when a results folder is open. The energies cost a product with every linear
 stiffness, and the J2 model's stored energy 3.6 of its internal-force evaluations (measured),
-hence the samples. SI units.
+hence the samples. An adaptive run's rejected interval (``on_rewind``) drops the steps, samples
+and ``impact.csv`` rows taken after the committed time. SI units.
 """
 
 from __future__ import annotations
@@ -51,6 +52,9 @@ class ImpactRecorder:
         self.balance: list[float] = []
         self.scale = 0.0
         self.contact_radius = 0.0
+        # the running maxima per step / per sample, so that a rejected interval's can be undone
+        self._radii: list[float] = []
+        self._scales: list[float] = []
         self._pct = -1
         self.csv = folder.history(list(self.keys), HISTORY_UNITS, name="impact") if folder \
             else None  # fmt: skip
@@ -80,6 +84,7 @@ class ImpactRecorder:
         force = b.contact_force(integ.multipliers)
         self.times.append(integ.t)
         self.forces.append(force)
+        self._radii.append(self.contact_radius)
         if self.progress is not None:
             pct = int(100 * integ.t / self.t_end)
             if pct != self._pct:
@@ -98,6 +103,7 @@ class ImpactRecorder:
         if self._e0 is None:
             self._e0 = total
         self.scale = max(self.scale, abs(kinetic + strain))
+        self._scales.append(self.scale)
         self.balance.append(total - self._e0)
         elastic, plastic = strain, 0.0
         if self._j2_block is not None:
@@ -126,6 +132,27 @@ class ImpactRecorder:
         change = adapt.records[-1].energy_change
         if self._e0 is not None and change is not None:
             self._e0 += change
+
+    def on_rewind(self, integ) -> None:
+        """An interval was rejected, the integrator is back at its committed state: the steps
+        and samples after its time are dropped (from ``impact.csv`` too), the running maxima
+        (contact radius, energy scale; the peak force is taken from the kept steps) are those
+        of the kept records."""
+        t = integ.t
+        n = int(np.searchsorted(self.times, t, side="right"))
+        del self.times[n:], self.forces[n:], self._radii[n:]
+        self.contact_radius = self._radii[-1] if n else 0.0
+        m = int(np.searchsorted(self.rows["t"], t, side="right"))
+        for values in self.rows.values():
+            del values[m:]
+        del self.balance[m:], self._scales[m:]
+        self.scale = self._scales[-1] if m else 0.0
+        self._next = self.rows["t"][-1] + self.t_end / SAMPLES if m else 0.0
+        if not m:
+            self._e0 = None
+        if self.csv is not None:
+            self.csv.truncate(m)
+        self._pct = -1
 
     def result(self, res, wall: float, patch_fraction: float, hertz: dict,
                config: dict) -> BallImpactResult:  # fmt: skip
