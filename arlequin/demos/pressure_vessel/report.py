@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from ...geometry.facets import cyclic_quad_faces
 from ...io import ResultsFolder
 from .hill import cylinder_limit_load, sphere_limit_load, sphere_outer_displacement
 from .measures import von_mises
@@ -18,6 +19,7 @@ from .setup import VesselSetup
 __all__ = [
     "AdaptationPictures",
     "cell_fields",
+    "plane_polygons",
     "plot_patch_size",
     "plot_plastic_zone",
     "plot_pressure_curve",
@@ -70,33 +72,61 @@ def plot_pressure_curve(result: PressureVesselResult, config: dict, path: str) -
     plt.close(fig)
 
 
-def plot_plastic_zone(setup: VesselSetup, state: Any, path: str) -> None:
-    """ε̄p over the J2 model's cells at the end of the run, the coarse mesh's edges beside."""
+def plane_polygons(mesh: Any) -> tuple[np.ndarray, np.ndarray]:
+    """The mesh's cells as polygons in the plane of the pictures, and the cell of each.
+
+    A plane mesh gives its cells; a solid mesh the faces of its boundary lying on the symmetry
+    plane z = 0 (drawn in x, y), each with the cell it bounds, so the plastic zone of a 3D
+    run shows on that plane (matplotlib draws plane polygons only).
+
+    Parameters
+    ----------
+    mesh : skfem.Mesh
+        A 2D or 3D mesh.
+
+    Returns
+    -------
+    polygons : ndarray, shape (n_polygons, n_vertices, 2)
+        The vertices (m), in order around each polygon.
+    cells : ndarray of int, shape (n_polygons,)
+        The cell each polygon belongs to.
+    """
+    if mesh.p.shape[0] == 2:
+        return np.transpose(mesh.p[:, mesh.t], (2, 1, 0)), np.arange(mesh.t.shape[1])
+    facets = mesh.boundary_facets()
+    tol = 1e-9 * float(np.ptp(mesh.p, axis=1).max())
+    on_plane = np.all(np.abs(mesh.p[2, mesh.facets[:, facets]]) <= tol, axis=0)
+    facets = facets[on_plane]
+    nodes = mesh.facets[:, facets]
+    if nodes.shape[0] == 4:  # scikit-fem stores a hexahedron's faces with sorted vertices
+        nodes = cyclic_quad_faces(mesh.p, nodes)
+    return np.transpose(mesh.p[:2, nodes], (2, 1, 0)), mesh.f2t[0, facets]
+
+
+def plot_plastic_zone(setup: VesselSetup, state: Any, path: str,
+                      title: str = "plastic zone over the coarse mesh") -> None:  # fmt: skip
+    """ε̄p over the J2 model's cells at the end of the run, the coarse mesh's edges beside
+    (a 3D run: on its symmetry plane z = 0, :func:`plane_polygons`)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     from matplotlib.collections import PolyCollection
 
-    mesh = setup.plastic_model.mesh
-    polys = np.transpose(mesh.p[:, mesh.t], (2, 1, 0))
+    polys, cells = plane_polygons(setup.plastic_model.mesh)
     fig, ax = plt.subplots(figsize=(5, 5))
-    coll = PolyCollection(polys, array=np.asarray(state.eqps).mean(axis=1), cmap="viridis",
-                          edgecolors="none")  # fmt: skip
+    coll = PolyCollection(polys, array=np.asarray(state.eqps).mean(axis=1)[cells],
+                          cmap="viridis", edgecolors="none")  # fmt: skip
     ax.add_collection(coll)
-    coarse = setup.meshes.coarse
-    ax.add_collection(
-        PolyCollection(
-            np.transpose(coarse.p[:, coarse.t], (2, 1, 0)),
-            facecolors="none",
-            edgecolors="0.6",
-            linewidths=0.4,
-        )
-    )
+    coarse, _ = plane_polygons(setup.meshes.coarse)
+    ax.add_collection(PolyCollection(coarse, facecolors="none", edgecolors="0.6",
+                                     linewidths=0.4))  # fmt: skip
     ax.autoscale()
     ax.set_aspect("equal")
     fig.colorbar(coll, ax=ax, label="equivalent plastic strain")
-    ax.set_title("plastic zone over the coarse mesh", fontsize=10)
+    if setup.meshes.coarse.p.shape[0] == 3:
+        title += " (plane z = 0)"
+    ax.set_title(title, fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
