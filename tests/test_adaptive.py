@@ -331,3 +331,28 @@ def test_no_growth_after_the_last_step():
     result = solve_quasi_static(problem, steps=3, adapt=adapt)
     assert [r.step for r in result.adaptations] == [1, 2]
     assert result.problem.patches[0].model.mesh.nelements == 4 * adapt.cells.size
+
+
+@pytest.mark.parametrize("command", ["pressure-vessel", "plate-with-hole", "ball-impact"])
+@pytest.mark.parametrize(
+    ("flag", "value", "name"),
+    [("--adapt-threshold", "0.5", "adapt_threshold"), ("--adapt-buffer", "2", "adapt_buffer"),
+     ("--adapt-every", "7", "adapt_every"), ("--max-patch-fraction", "0.3", "max_patch_fraction")],
+)  # fmt: skip
+def test_adaptive_settings_without_adaptive_are_refused(command, flag, value, name, capsys):
+    """A setting of the growing patch given without --adaptive was silently ignored: now
+    refused (exit 2) naming the option and its value; its default given explicitly is not."""
+    import dataclasses
+
+    from arlequin.cli.main import main
+    from arlequin.demos.ball_impact import BallImpactConfig
+    from arlequin.demos.plate_with_hole import PlateWithHoleConfig
+    from arlequin.demos.pressure_vessel import PressureVesselConfig
+
+    assert main([command, flag, value, "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert name in err and value in err and "--adaptive" in err
+    config = {"pressure-vessel": PressureVesselConfig, "plate-with-hole": PlateWithHoleConfig,
+              "ball-impact": BallImpactConfig}[command]  # fmt: skip
+    default = {f.name: f.default for f in dataclasses.fields(config)}[name]
+    config(**{name: default}).check()  # the default, given explicitly: accepted

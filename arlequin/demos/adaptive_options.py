@@ -8,6 +8,7 @@ and record them with :func:`adaptive_inputs`.
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any
 
 from .config import check_range, option
@@ -57,13 +58,26 @@ def _count(name: str, value: Any, low: int) -> None:
         raise ValueError(f"{name} must be an integer >= {low}, got {name}={value!r}")
 
 
+_SETTINGS = ("adapt_threshold", "adapt_buffer", "adapt_every", "max_patch_fraction")
+
+
 def check_adaptive_options(config: Any) -> None:
     """Refuse β outside (0, 1], a negative buffer, a spacing < 1 and a cap outside (0, 1]
-    (checked with or without ``adaptive``, so a bad value never waits for the flag)."""
+    (checked with or without ``adaptive``, so a bad value never waits for the flag), and a
+    setting other than its default without ``adaptive`` (it would be silently ignored)."""
     check_range("adapt_threshold", config.adapt_threshold, 0.0, 1.0, closed="(]")
     _count("adapt_buffer", config.adapt_buffer, 0)
     _count("adapt_every", config.adapt_every, 1)
     check_range("max_patch_fraction", config.max_patch_fraction, 0.0, 1.0, closed="(]")
+    if config.adaptive:
+        return
+    defaults = {f.name: f.default for f in dataclasses.fields(config)}
+    for name in _SETTINGS:
+        value = getattr(config, name)
+        if value != defaults[name]:
+            flag = "--" + name.replace("_", "-")
+            raise ValueError(f"{name}={value!r} ({flag}) applies to an adaptive patch only: "
+                             "add --adaptive, or drop it")  # fmt: skip
 
 
 def adaptive_inputs(config: Any) -> dict[str, Any]:
