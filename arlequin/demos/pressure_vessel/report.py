@@ -11,6 +11,7 @@ import numpy as np
 
 from ...geometry.facets import cyclic_quad_faces
 from ...io import ResultsFolder
+from ..adaptive_options import growth_title
 from .hill import cylinder_limit_load, sphere_limit_load, sphere_outer_displacement
 from .measures import von_mises
 from .result import PressureVesselResult
@@ -146,8 +147,10 @@ class AdaptationPictures:
     """A listener of an adaptive run: the plastic zone over the grown patch, one picture a
     growth (``patch_K.png``, from the fields the growth started from, re-solved)."""
 
-    def __init__(self, folder: ResultsFolder, setup: VesselSetup) -> None:
-        self.folder, self.setup, self.count = folder, setup, 0
+    def __init__(self, folder: ResultsFolder, setup: VesselSetup,
+                 history: dict[str, list[Any]]) -> None:  # fmt: skip
+        # history: the recorder's, whose last pressure is the committed state's (the growth's)
+        self.folder, self.setup, self.history, self.count = folder, setup, history, 0
 
     def __call__(self, solver: Any) -> None:
         """Nothing after a step."""
@@ -156,11 +159,23 @@ class AdaptationPictures:
         """A picture of the patch just grown (called by the adaptation after each growth)."""
         self.count += 1
         state = solver.states[self.setup.plastic_block][0]
-        plot_plastic_zone(self.setup, state, str(self.folder.picture(f"patch_{self.count}")))
+        rec = adapt.records[-1]
+        pressure = self.history["pressure"][-1]  # the committed step the patch grew from
+        title = growth_title(self.count, f"P = {pressure / 1e6:.4g} MPa (step {rec.step})",
+                             rec.rejected, f"{rec.patch_fraction:.3f} of the wall")  # fmt: skip
+        plot_plastic_zone(self.setup, state, str(self.folder.picture(f"patch_{self.count}")),
+                          title)  # fmt: skip
 
 
 def plot_patch_size(result: PressureVesselResult, path: str) -> None:
-    """The patch's share of the wall and the plastic front against the bore pressure."""
+    """The patch's share of the wall and the plastic zone's, in the same measure, against the
+    bore pressure.
+
+    The patch's share is of the wall's section area (2D: the quarter annulus of the plane-strain
+    cylinder or the sphere's meridian section; 3D: of the octant's volume); the plastic zone
+    a ≤ r ≤ c covers (c² − a²)/(b² − a²) of that area in 2D, (c³ − a³)/(b³ − a³) of the volume
+    in 3D, so the two curves compare (the patch must stay above the plastic zone).
+    """
     import matplotlib
 
     matplotlib.use("Agg")
@@ -168,13 +183,19 @@ def plot_patch_size(result: PressureVesselResult, path: str) -> None:
 
     h = result.history
     p = np.array(h["pressure"]) / 1e6
-    fig, ax = plt.subplots(figsize=(6, 4))
-    ax.step(p, h["patch_fraction"], where="post", label="patch (share of the wall)")
     a, b = result.config["inner"], result.config["outer"]
-    front = (np.array(h["plastic_radius"]) - a) / (b - a)
-    ax.plot(p, front, "o-", label="plastic front (share of the wall thickness)")
+    dim = int(result.config.get("dim", 2))
+    measure = "volume" if dim == 3 else "section area"
+    c = np.clip(np.array(h["plastic_radius"], dtype=float), a, b)
+    plastic = (c**dim - a**dim) / (b**dim - a**dim)
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.step(p, h["patch_fraction"], where="post", label="J2 patch")
+    ax.plot(p, plastic, "o-", label="plastic zone a ≤ r ≤ c")
     ax.set_xlabel("bore pressure (MPa)")
+    ax.set_ylabel(f"share of the wall's {measure}")
     ax.set_ylim(0.0, 1.05)
+    ax.set_title(f"adaptive patch: {len(result.adaptations)} growths, plastic front c "
+                 f"{c[-1] * 1e3:.4g} mm at {p[-1]:.4g} MPa", fontsize=10)  # fmt: skip
     ax.legend()
     fig.tight_layout()
     fig.savefig(path, dpi=120)
