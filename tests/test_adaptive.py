@@ -213,7 +213,7 @@ def test_an_adaptive_patch_used_again_starts_afresh():
 SMALL = {"coarse_size": 0.025, "fine_size": 0.025 / 4, "pressure": 2e8, "steps": 5}
 
 
-def test_adaptive_sphere_cli_json_series_and_history(tmp_path):
+def test_adaptive_sphere_cli_json_series_and_history(tmp_path, capsys):
     """4 coarse rings, 200 MPa in 5 steps (c = 116 mm): the one-ring seed yields in its band
     at step 4, which is computed again on 3 rings (measured: energy jump 2.1e-2 at this
     resolution, coarse σ_vm/σy at most 0.35). The patch's frames go into a new series after
@@ -221,6 +221,7 @@ def test_adaptive_sphere_cli_json_series_and_history(tmp_path):
     import json
 
     from arlequin.cli.main import main
+    from arlequin.demos.adaptive_options import ADAPTATIONS_UNIT
     from arlequin.io import read_history, read_series
 
     out, js = tmp_path / "run", tmp_path / "pv.json"
@@ -244,6 +245,21 @@ def test_adaptive_sphere_cli_json_series_and_history(tmp_path):
     assert len(mesh.points) > 0
     assert len(read_history(out / "newton.csv")["load_factor"]) == 5
     assert (out / "patch_1.png").exists() and (out / "patch_size.png").exists()
+    meta = json.loads((out / "results.json").read_text())
+    assert meta["results"]["adaptations"]["unit"] == ADAPTATIONS_UNIT
+    summary = capsys.readouterr().out
+    assert "the patch grew 1 times to" in summary and "coarse σ_vm/σy ≤ 0.3" in summary
+
+
+def test_growth_titles_say_the_load_and_a_rejected_step():
+    """patch_K.png's title: the growth, the load it grew at, a rejected step, the share."""
+    from arlequin.demos.adaptive_options import growth_title
+
+    title = growth_title(2, "P = 120 MPa (step 4)", True, "0.688 of the wall")
+    assert (
+        title == "growth 2 at P = 120 MPa (step 4), after a rejected step\npatch: 0.688 of the wall"
+    )
+    assert "rejected" not in growth_title(1, "t = 3 µs", False, "0.1 of the block")
 
 
 def test_adaptive_sphere_cap_stops_the_run_with_the_steps_on_disk(tmp_path):
@@ -383,3 +399,28 @@ def test_no_growth_after_the_last_step():
     result = solve_quasi_static(problem, steps=3, adapt=adapt)
     assert [r.step for r in result.adaptations] == [1, 2]
     assert result.problem.patches[0].model.mesh.nelements == 4 * adapt.cells.size
+
+
+@pytest.mark.parametrize("command", ["pressure-vessel", "plate-with-hole", "ball-impact"])
+@pytest.mark.parametrize(
+    ("flag", "value", "name"),
+    [("--adapt-threshold", "0.5", "adapt_threshold"), ("--adapt-buffer", "2", "adapt_buffer"),
+     ("--adapt-every", "7", "adapt_every"), ("--max-patch-fraction", "0.3", "max_patch_fraction")],
+)  # fmt: skip
+def test_adaptive_settings_without_adaptive_are_refused(command, flag, value, name, capsys):
+    """A setting of the growing patch given without --adaptive was silently ignored: now
+    refused (exit 2) naming the option and its value; its default given explicitly is not."""
+    import dataclasses
+
+    from arlequin.cli.main import main
+    from arlequin.demos.ball_impact import BallImpactConfig
+    from arlequin.demos.plate_with_hole import PlateWithHoleConfig
+    from arlequin.demos.pressure_vessel import PressureVesselConfig
+
+    assert main([command, flag, value, "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert name in err and value in err and "--adaptive" in err
+    config = {"pressure-vessel": PressureVesselConfig, "plate-with-hole": PlateWithHoleConfig,
+              "ball-impact": BallImpactConfig}[command]  # fmt: skip
+    default = {f.name: f.default for f in dataclasses.fields(config)}[name]
+    config(**{name: default}).check()  # the default, given explicitly: accepted

@@ -161,6 +161,9 @@ def test_ball_on_the_elastic_block_against_hertz(tmp_path):
     assert r.energy_balance_error < 1e-3
     data = json.loads((tmp_path / "run" / "results.json").read_text())
     assert data["status"] == "complete"
+    assert data["message"] == f"reached t = {r.t_end:.6g} s"  # like the other demos'
+    # the count ratio's unit says it is not the adaptive history's area share
+    assert "elements" in data["results"]["patch_fraction"]["unit"]
     for name in ("impact.csv", "history.csv", "ball_impact.png", "fields/ball.patch.xdmf",
                  "fields/block.coarse.xdmf"):  # fmt: skip
         assert (tmp_path / "run" / name).stat().st_size > 0

@@ -261,3 +261,68 @@ def test_sphere_eighth_in_hexahedra_against_hill():
     r = run_pressure_vessel(dim=3, model="mono", coarse_size=0.025, fine_size=0.00625)
     ub = hill.sphere_outer_displacement(300e6, A, B, E, NU, SY)
     assert r.history["outer_displacement"][-1] == pytest.approx(ub, rel=0.01)
+
+
+def test_3d_pictures_draw_the_symmetry_plane():
+    """A 3D mesh is drawn by its boundary faces on z = 0: for the octant with n = 2 and two
+    shells, the plane's arc from x to y is cut in 2n = 4 segments, so 4 × 2 = 8 quadrilaterals;
+    their areas (shoelace, vertices in order around each face) sum to the quarter annulus
+    π (b² − a²)/4 less the chords' segments: exactly Σ ½ (r₂² − r₁²) sin Δθ over the
+    straight-sided cells, from the arc's node angles."""
+    import skfem
+
+    from arlequin.demos.pressure_vessel.meshes_3d import octant_sphere_mesh
+    from arlequin.demos.pressure_vessel.report import plane_polygons
+
+    a, b = 0.1, 0.2
+    mesh = octant_sphere_mesh(a, b, 2, 2)
+    polys, cells = plane_polygons(mesh)
+    assert polys.shape == (8, 4, 2) and cells.shape == (8,)
+    x, y = polys[..., 0], polys[..., 1]
+    area = 0.5 * (x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y).sum(axis=1)
+    assert np.all(np.abs(area) > 0.0)
+    on_arc = np.abs(np.hypot(mesh.p[0], mesh.p[1]) - a) < 1e-12 * b
+    theta = np.sort(np.arctan2(mesh.p[1], mesh.p[0])[on_arc & (np.abs(mesh.p[2]) < 1e-15)])
+    exact = 0.5 * (b**2 - a**2) * np.sin(np.diff(theta)).sum()
+    assert np.abs(area).sum() == pytest.approx(exact, rel=1e-12)
+    # the cell of each face touches z = 0 with four nodes
+    assert np.all((np.abs(mesh.p[2, mesh.t[:, cells]]) < 1e-15).sum(axis=0) == 4)
+    # a plane mesh: its own cells
+    polys2, cells2 = plane_polygons(skfem.MeshQuad())
+    assert polys2.shape == (1, 4, 2) and list(cells2) == [0]
+
+
+def test_any_failure_leaves_the_folder_failed_with_its_message(tmp_path, monkeypatch):
+    """An exception the demo does not expect (here a picture that cannot be drawn) ends the
+    folder's results.json with status "failed" and the error, not "running"."""
+    from arlequin.cli.main import main
+    from arlequin.demos.pressure_vessel import report
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("no picture")
+
+    monkeypatch.setattr(report, "plot_pressure_curve", broken)
+    out = tmp_path / "run"
+    argv = ["pressure-vessel", "--shape", "cylinder", "--pressure", "1.5e8", "--steps", "1",
+            "--coarse-size", "0.025", "--fine-size", "0.0125", "--out", str(out),
+            "--quiet"]  # fmt: skip
+    assert main(argv) == 1
+    meta = json.loads((out / "results.json").read_text())
+    assert meta["status"] == "failed"
+    assert meta["message"] == "RuntimeError: no picture"
+
+
+@pytest.mark.slow
+def test_3d_adaptive_run_draws_its_growths(tmp_path):
+    """The new user's command (about 13 s): the 3D adaptive run draws patch_1.png at its first
+    growth (it died there on a 3D PolyCollection), then stops at the patch's cap, the folder
+    saying why."""
+    from arlequin.cli.main import main
+
+    out = tmp_path / "run"
+    argv = ["pressure-vessel", "--dim", "3", "--adaptive", "--coarse-size", "0.025",
+            "--fine-size", "0.0125", "--steps", "3", "--out", str(out), "--quiet"]  # fmt: skip
+    assert main(argv) == 1
+    assert (out / "patch_1.png").exists()
+    meta = json.loads((out / "results.json").read_text())
+    assert meta["status"] == "failed" and "max_fraction" in meta["message"]

@@ -11,11 +11,13 @@ summary line and writes its JSON.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from typing import Any
 
 from ..demos.config import DemoConfig, Option
+from ..io import close_running
 from .common import add_out, progress_bar, write_json
 
 __all__ = ["add_demo", "config_from_args", "parse_type", "run_command"]
@@ -122,7 +124,7 @@ def _resume(config: type[DemoConfig], args: argparse.Namespace) -> Any:
     if args.out is None:
         raise ValueError("--resume needs --out DIR, the results folder of the interrupted run")
     total, unit, scale, label = config.resume_progress_scale(args.out)
-    with progress_bar(total, unit, args.quiet, scale, label) as update:
+    with progress_bar(total, unit, args.quiet, scale, label) as update, _ended(args.out):
         result = config.resume(args.out, progress=update)
     print(result.summary())
     write_json(args.json, result.to_json())
@@ -136,12 +138,28 @@ def config_from_args(config: type[DemoConfig], args: argparse.Namespace) -> Demo
     return config.from_mapping(values)
 
 
+@contextlib.contextmanager
+def _ended(out: str | None) -> Iterator[None]:
+    """A run whose exception leaves ``out``'s results.json ``"failed"`` (``"interrupted"`` on
+    Ctrl-C) with the exception's text, whatever raised it (see :func:`close_running`)."""
+    try:
+        yield
+    except KeyboardInterrupt:
+        close_running(out, "interrupted", "interrupted")
+        raise
+    except Exception as exc:
+        close_running(out, "failed", f"{type(exc).__name__}: {exc}")
+        raise
+
+
 def run_command(config: DemoConfig, args: argparse.Namespace) -> Any:
     """Run a demo from its parsed options: under its progress bar (none with ``--quiet``), its
     summary line printed and its JSON written to ``--json``; returns the result."""
     total, unit, scale, label = config.progress_scale()
-    with progress_bar(total, unit, getattr(args, "quiet", False), scale, label) as update:
-        result = config.run(out=getattr(args, "out", None), progress=update)
+    out = getattr(args, "out", None)
+    with progress_bar(total, unit, getattr(args, "quiet", False), scale, label) as update, \
+            _ended(out):  # fmt: skip
+        result = config.run(out=out, progress=update)
     print(result.summary())
     write_json(getattr(args, "json", None), result.to_json())
     return result

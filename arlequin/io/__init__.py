@@ -9,7 +9,14 @@ demos and the CLI do.
 
 from .checkpoint import CheckpointError, read_checkpoint, write_checkpoint
 from .fields import FieldSeries, meshio_mesh, read_series
-from .folder import RESULTS_JSON, JsonResult, ResultsFolder, environment, jsonable
+from .folder import (
+    RESULTS_JSON,
+    JsonResult,
+    ResultsFolder,
+    close_running,
+    environment,
+    jsonable,
+)
 from .history import HistoryCSV, read_history
 from .layout import BlockFields, FieldLayout
 from .meshes import UnsupportedMeshError, read_mesh
@@ -27,6 +34,7 @@ __all__ = [
     "QuasiStaticRunWriter",
     "ResultsFolder",
     "UnsupportedMeshError",
+    "close_running",
     "environment",
     "jsonable",
     "meshio_mesh",

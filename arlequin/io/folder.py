@@ -31,7 +31,14 @@ import numpy as np
 from .fields import FieldSeries
 from .history import HistoryCSV
 
-__all__ = ["RESULTS_JSON", "JsonResult", "ResultsFolder", "environment", "jsonable"]
+__all__ = [
+    "RESULTS_JSON",
+    "JsonResult",
+    "ResultsFolder",
+    "close_running",
+    "environment",
+    "jsonable",
+]
 
 RESULTS_JSON = "results.json"
 
@@ -219,3 +226,43 @@ class ResultsFolder:
     def __exit__(self, exc_type, exc, tb) -> None:
         if self.meta["status"] == "running":
             self.finish("failed" if exc is not None else "complete", str(exc or ""))
+
+
+def close_running(path: str | os.PathLike | None, status: str, message: str) -> bool:
+    """End the ``results.json`` of ``path`` left ``"running"`` by a run that raised.
+
+    A demo marks its own folder when it catches the failure it expects (a Newton failure, the
+    patch's cap); any other exception (a picture that cannot be drawn, a bug) would otherwise
+    leave ``"status": "running"`` and no message. The CLI calls this after every failed run, so
+    the folder of each demo says how the run ended; a folder already ended is left as it is.
+
+    Parameters
+    ----------
+    path : str or Path or None
+        The results folder (``None``, or a folder without ``results.json``: nothing done).
+    status : str
+        The final status (``"failed"``, ``"interrupted"``).
+    message : str
+        Why (the exception's text).
+
+    Returns
+    -------
+    bool
+        Whether ``results.json`` was rewritten.
+    """
+    if path is None:
+        return False
+    file = Path(path) / RESULTS_JSON
+    try:
+        meta = json.loads(file.read_text(encoding="utf-8"))
+    except (OSError, ValueError):  # no folder yet (bad input), or not ours: nothing to end
+        return False
+    if meta.get("status") != "running":
+        return False
+    meta["status"] = status
+    meta["message"] = message
+    meta["finished"] = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
+    tmp = file.with_name(RESULTS_JSON + ".tmp")
+    tmp.write_text(json.dumps(jsonable(meta), indent=2) + "\n", encoding="utf-8")
+    os.replace(tmp, file)
+    return True

@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from ..adaptive_options import growth_title
 from .result import RESULT_UNITS, BallImpactResult, hertz_force_history
 
 __all__ = ["AdaptationPictures", "picture", "plot_block_patch", "plot_patch_size",
@@ -134,8 +135,8 @@ class AdaptationPictures:
         """The picture of the patch just grown."""
         self.count += 1
         rec = adapt.records[-1]
-        title = (f"growth {self.count}, t = {rec.time * 1e6:.3g} µs (step {rec.step}): "
-                 f"{rec.patch_fraction:.3f} of the block")  # fmt: skip
+        title = growth_title(self.count, f"t = {rec.time * 1e6:.3g} µs", rec.rejected,
+                             f"{rec.patch_fraction:.3f} of the block")  # fmt: skip
         plot_block_patch(self.bodies, integ.states,
                          str(self.folder.picture(f"patch_{self.count}")), title)  # fmt: skip
 
@@ -178,4 +179,5 @@ def write_outputs(folder, result: BallImpactResult, bodies, res) -> None:
     if "patch_fraction" in result.history:  # an adaptive block patch
         growths = [(a["time"], a["patch_fraction"]) for a in result.adaptations]
         plot_patch_size(result.history, growths, str(folder.picture("patch_size")))
-    folder.finish()
+    # a message like the other demos' (the quasi-static ones say where the load stopped)
+    folder.finish("complete", f"reached t = {result.t_end:.6g} s")

@@ -13,6 +13,7 @@ import numpy as np
 
 from ...io import JsonResult
 from ...models import IsotropicElastic
+from ..adaptive_options import ADAPTATIONS_UNIT
 
 __all__ = [
     "HISTORY_KEYS",
@@ -42,14 +43,21 @@ INPUT_UNITS = {"regime": "", "model": "", "velocity": "m/s", "ball_radius": "m",
                "t_end": "s", "ball_material": "", "block_material": "", "adaptive": "",
                "adapt_threshold": "1", "adapt_buffer": "1", "adapt_every": "1",
                "max_patch_fraction": "1"}  # fmt: skip
+#: The result's ``patch_fraction`` is a count ratio, unlike the adaptive history's and the
+#: growths' ``patch_fraction`` (an area share of the block): the unit says which.
+PATCH_FRACTION_UNIT = (
+    "1 (the patches' elements over those of the uniformly fine meshes of both bodies; the "
+    "references: all their elements over the uniform meshes'. Not the block patch's area "
+    "share, which history.csv's and adaptations' patch_fraction give)"
+)
 RESULT_UNITS = {"contact_duration": "s", "peak_force": "N", "restitution": "1",
                 "dent_depth": "m", "max_plastic_strain": "1", "energy_balance_error": "1",
-                "patch_fraction": "1", "n_elements": "1", "wall_time_s": "s",
+                "patch_fraction": PATCH_FRACTION_UNIT, "n_elements": "1", "wall_time_s": "s",
                 "hertz_peak_force": "N", "hertz_contact_duration": "s",
                 "hertz_indentation": "m", "hertz_contact_radius": "m", "fine_size": "m",
                 "coarse_size": "m", "n_steps": "1", "contact_radius_cells": "1",
                 "band_max_plastic_strain": "1", "t_end": "s",
-                "mean_step_ratio": "1", "adaptations": "",
+                "mean_step_ratio": "1", "adaptations": ADAPTATIONS_UNIT,
                 "max_coarse_yield_ratio": "1"}  # fmt: skip
 
 
@@ -95,7 +103,8 @@ class BallImpactResult(JsonResult):
     patch_fraction : float
         p: the patches' elements over those of the uniformly fine (``mono``) meshes of both
         bodies (1); for the references, all their elements over the uniform meshes' (1 for
-        ``mono`` and ``mono-zoned``).
+        ``mono`` and ``mono-zoned``). A ratio of element counts, unlike the area share of
+        ``history["patch_fraction"]`` and of the ``adaptations`` (:data:`PATCH_FRACTION_UNIT`).
     n_elements : int
         Elements of the run (every mesh).
     wall_time_s : float
@@ -108,7 +117,8 @@ class BallImpactResult(JsonResult):
         ``plastic_dissipation``, ``contact_work`` (of the normal multipliers),
         ``coupling_work``, ``friction_work`` (of the tangential multipliers, ≤ 0; 0 without
         friction) (J); with ``adaptive``, ``patch_fraction`` (the block patch's share of the
-        block's coarse mesh's (r, z) area, 1).
+        block's coarse mesh's (r, z) area, 1: not the result's ``patch_fraction``, a ratio of
+        element counts over both bodies).
     hertz : dict
         Hertz's values (elastic regime; empty otherwise).
     contact_radius_cells : float
@@ -124,9 +134,10 @@ class BallImpactResult(JsonResult):
         The mean ratio m ≤ M the coarse models' macro steps used (1 without multi-time-step).
     adaptations : list of dict
         With ``adaptive``: each growth of the block's patch, ``step`` (the time step it grew
-        at), ``time`` (s), ``n_fine_elements``, ``patch_fraction`` (of the block's coarse
-        mesh), ``energy_jump`` (relative change of the total energy across it), ``rejected``
-        (the interval after it was computed again: the coarse block yielded outside the patch).
+        at), ``time`` (s), ``n_fine_elements``, ``patch_fraction`` (the share of the block's
+        coarse mesh's (r, z) area, as in ``history``), ``energy_jump`` (relative change of
+        the total energy across it), ``rejected`` (the interval after it was computed again:
+        the coarse block yielded outside the patch).
     max_coarse_yield_ratio : float or None
         With ``adaptive``: the largest von Mises / σy of the block's coarse model outside the
         patch at the accepted checks (1).
@@ -184,4 +195,15 @@ class BallImpactResult(JsonResult):
                 f"restitution {self.restitution:.4f}, dent {self.dent_depth:.4g} m, max eqps "
                 f"{self.max_plastic_strain:.4g}, balance {self.energy_balance_error:.2e}, "
                 f"{self.n_elements} elements (p = {self.patch_fraction:.3f}), "
-                f"{self.wall_time_s:.1f} s")  # fmt: skip
+                f"{self.wall_time_s:.1f} s{self._growths()}")  # fmt: skip
+
+    def _growths(self) -> str:
+        """An adaptive run's growths, the block patch's last area share and the largest
+        coarse σ_vm/σy (as the plate says)."""
+        if not self.config.get("adaptive"):
+            return ""
+        share = (f" to {self.adaptations[-1]['patch_fraction']:.3f} of the block"
+                 if self.adaptations else "")  # fmt: skip
+        ratio = self.max_coarse_yield_ratio
+        return (f"; the block patch grew {len(self.adaptations)} times{share}, coarse "
+                f"σ_vm/σy ≤ {float('nan') if ratio is None else ratio:.3f}")  # fmt: skip

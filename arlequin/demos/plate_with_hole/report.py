@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from ...io import ResultsFolder
+from ..adaptive_options import growth_title
 from .result import PlateWithHoleResult
 from .setup import PlateSetup
 
@@ -94,7 +95,7 @@ def plot_plastic_zone(setup: PlateSetup, state: Any, path: str, radius: float,
     ax.set_ylim(0.0, 5.0 * radius)
     ax.set_aspect("equal")
     fig.colorbar(coll, ax=ax, label="equivalent plastic strain")
-    ax.set_title(title)
+    ax.set_title(title, fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
@@ -104,8 +105,11 @@ class AdaptationPictures:
     """A listener of an adaptive run: the plastic zone over the grown patch, one picture a
     growth (``patch_K.png``, from the fields re-solved after it)."""
 
-    def __init__(self, folder: ResultsFolder, setup: PlateSetup, radius: float) -> None:
-        self.folder, self.setup, self.radius, self.count = folder, setup, radius, 0
+    def __init__(self, folder: ResultsFolder, setup: PlateSetup, radius: float,
+                 load: float) -> None:  # fmt: skip
+        # load: the full remote traction S (Pa), the growths' load factors scale it
+        self.folder, self.setup, self.radius, self.load, self.count = folder, setup, radius, \
+            load, 0  # fmt: skip
 
     def __call__(self, solver: Any) -> None:
         """Nothing after a step."""
@@ -116,8 +120,9 @@ class AdaptationPictures:
         s = self.setup
         state = solver.states[s.plastic_block][s.plastic_term]
         rec = adapt.records[-1]
-        title = (f"growth {self.count} after step {rec.step}: {rec.patch_fraction:.3f} of the "
-                 "plate")  # fmt: skip
+        load = f"S = {rec.time * self.load / 1e6:.4g} MPa (step {rec.step})"
+        title = growth_title(self.count, load, rec.rejected, f"{rec.patch_fraction:.3f} of the "
+                             "plate")  # fmt: skip
         plot_plastic_zone(s, state, str(self.folder.picture(f"patch_{self.count}")),
                           self.radius, title)  # fmt: skip
 

@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ...io import JsonResult
+from ..adaptive_options import ADAPTATIONS_UNIT
 
 __all__ = ["HISTORY_KEYS", "JSON_KEYS", "UNITS", "PlateWithHoleResult"]
 
@@ -30,6 +31,7 @@ UNITS = {
     "max_coarse_yield_ratio": "1",
     "plastic_cover_fraction": "1",
     "band_fraction": "1",
+    "adaptations": ADAPTATIONS_UNIT,
 }
 
 

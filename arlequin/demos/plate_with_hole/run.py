@@ -7,7 +7,6 @@ import logging
 import time
 import warnings
 from collections.abc import Callable
-from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -17,6 +16,7 @@ from ...io import QuasiStaticRunWriter, ResultsFolder
 from ...problem.adapt import cell_rings
 from ...solvers import NewtonError, QuasiStaticSolver
 from ...solvers.adaptive import run_adaptive
+from ..adaptive_options import fixed_patch
 from .result import HISTORY_KEYS, UNITS, PlateWithHoleResult
 from .setup import PlateSetup, area, build, loaded_edge_average
 
@@ -131,7 +131,7 @@ def _first_yield_of_seed(config: PlateWithHoleConfig) -> float:
     quarter hole miss part of the stress concentration (1 level: first yield at 98.72 MPa on
     the seed, 96.08 on that patch, 95.92 on the default fixed patch)."""
     band = config.gluing_rings * config.coarse_size
-    probe = replace(config, adaptive=False, patch_radius=config.block + band)
+    probe = fixed_patch(config, patch_radius=config.block + band)
     setup = build(probe)
     return _probe(QuasiStaticSolver(setup.problem, load=1.0, steps=1), setup, config.yield_stress)
 
@@ -249,7 +249,8 @@ def _listeners(setup: PlateSetup, system: Any, folder: ResultsFolder | None,
         listeners.append(QuasiStaticRunWriter(folder, system, layout, cell_fields(setup), units))
         listeners.append(lambda solver: folder.add_results(recorder.results(), UNITS))
         if setup.adapt is not None:
-            listeners.append(AdaptationPictures(folder, setup, recorder.config.radius))
+            listeners.append(AdaptationPictures(folder, setup, recorder.config.radius,
+                                                recorder.config.load))  # fmt: skip
     if progress is not None:
         listeners.append(lambda solver: progress(solver.t))
     return listeners

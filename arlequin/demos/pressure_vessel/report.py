@@ -9,7 +9,9 @@ from typing import Any
 
 import numpy as np
 
+from ...geometry.facets import cyclic_quad_faces
 from ...io import ResultsFolder
+from ..adaptive_options import growth_title
 from .hill import cylinder_limit_load, sphere_limit_load, sphere_outer_displacement
 from .measures import von_mises
 from .result import PressureVesselResult
@@ -18,6 +20,7 @@ from .setup import VesselSetup
 __all__ = [
     "AdaptationPictures",
     "cell_fields",
+    "plane_polygons",
     "plot_patch_size",
     "plot_plastic_zone",
     "plot_pressure_curve",
@@ -70,33 +73,61 @@ def plot_pressure_curve(result: PressureVesselResult, config: dict, path: str) -
     plt.close(fig)
 
 
-def plot_plastic_zone(setup: VesselSetup, state: Any, path: str) -> None:
-    """ε̄p over the J2 model's cells at the end of the run, the coarse mesh's edges beside."""
+def plane_polygons(mesh: Any) -> tuple[np.ndarray, np.ndarray]:
+    """The mesh's cells as polygons in the plane of the pictures, and the cell of each.
+
+    A plane mesh gives its cells; a solid mesh the faces of its boundary lying on the symmetry
+    plane z = 0 (drawn in x, y), each with the cell it bounds, so the plastic zone of a 3D
+    run shows on that plane (matplotlib draws plane polygons only).
+
+    Parameters
+    ----------
+    mesh : skfem.Mesh
+        A 2D or 3D mesh.
+
+    Returns
+    -------
+    polygons : ndarray, shape (n_polygons, n_vertices, 2)
+        The vertices (m), in order around each polygon.
+    cells : ndarray of int, shape (n_polygons,)
+        The cell each polygon belongs to.
+    """
+    if mesh.p.shape[0] == 2:
+        return np.transpose(mesh.p[:, mesh.t], (2, 1, 0)), np.arange(mesh.t.shape[1])
+    facets = mesh.boundary_facets()
+    tol = 1e-9 * float(np.ptp(mesh.p, axis=1).max())
+    on_plane = np.all(np.abs(mesh.p[2, mesh.facets[:, facets]]) <= tol, axis=0)
+    facets = facets[on_plane]
+    nodes = mesh.facets[:, facets]
+    if nodes.shape[0] == 4:  # scikit-fem stores a hexahedron's faces with sorted vertices
+        nodes = cyclic_quad_faces(mesh.p, nodes)
+    return np.transpose(mesh.p[:2, nodes], (2, 1, 0)), mesh.f2t[0, facets]
+
+
+def plot_plastic_zone(setup: VesselSetup, state: Any, path: str,
+                      title: str = "plastic zone over the coarse mesh") -> None:  # fmt: skip
+    """ε̄p over the J2 model's cells at the end of the run, the coarse mesh's edges beside
+    (a 3D run: on its symmetry plane z = 0, :func:`plane_polygons`)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     from matplotlib.collections import PolyCollection
 
-    mesh = setup.plastic_model.mesh
-    polys = np.transpose(mesh.p[:, mesh.t], (2, 1, 0))
+    polys, cells = plane_polygons(setup.plastic_model.mesh)
     fig, ax = plt.subplots(figsize=(5, 5))
-    coll = PolyCollection(polys, array=np.asarray(state.eqps).mean(axis=1), cmap="viridis",
-                          edgecolors="none")  # fmt: skip
+    coll = PolyCollection(polys, array=np.asarray(state.eqps).mean(axis=1)[cells],
+                          cmap="viridis", edgecolors="none")  # fmt: skip
     ax.add_collection(coll)
-    coarse = setup.meshes.coarse
-    ax.add_collection(
-        PolyCollection(
-            np.transpose(coarse.p[:, coarse.t], (2, 1, 0)),
-            facecolors="none",
-            edgecolors="0.6",
-            linewidths=0.4,
-        )
-    )
+    coarse, _ = plane_polygons(setup.meshes.coarse)
+    ax.add_collection(PolyCollection(coarse, facecolors="none", edgecolors="0.6",
+                                     linewidths=0.4))  # fmt: skip
     ax.autoscale()
     ax.set_aspect("equal")
     fig.colorbar(coll, ax=ax, label="equivalent plastic strain")
-    ax.set_title("plastic zone over the coarse mesh", fontsize=10)
+    if setup.meshes.coarse.p.shape[0] == 3:
+        title += " (plane z = 0)"
+    ax.set_title(title, fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
@@ -116,8 +147,10 @@ class AdaptationPictures:
     """A listener of an adaptive run: the plastic zone over the grown patch, one picture a
     growth (``patch_K.png``, from the fields the growth started from, re-solved)."""
 
-    def __init__(self, folder: ResultsFolder, setup: VesselSetup) -> None:
-        self.folder, self.setup, self.count = folder, setup, 0
+    def __init__(self, folder: ResultsFolder, setup: VesselSetup,
+                 history: dict[str, list[Any]]) -> None:  # fmt: skip
+        # history: the recorder's, whose last pressure is the committed state's (the growth's)
+        self.folder, self.setup, self.history, self.count = folder, setup, history, 0
 
     def __call__(self, solver: Any) -> None:
         """Nothing after a step."""
@@ -126,11 +159,23 @@ class AdaptationPictures:
         """A picture of the patch just grown (called by the adaptation after each growth)."""
         self.count += 1
         state = solver.states[self.setup.plastic_block][0]
-        plot_plastic_zone(self.setup, state, str(self.folder.picture(f"patch_{self.count}")))
+        rec = adapt.records[-1]
+        pressure = self.history["pressure"][-1]  # the committed step the patch grew from
+        title = growth_title(self.count, f"P = {pressure / 1e6:.4g} MPa (step {rec.step})",
+                             rec.rejected, f"{rec.patch_fraction:.3f} of the wall")  # fmt: skip
+        plot_plastic_zone(self.setup, state, str(self.folder.picture(f"patch_{self.count}")),
+                          title)  # fmt: skip
 
 
 def plot_patch_size(result: PressureVesselResult, path: str) -> None:
-    """The patch's share of the wall and the plastic front against the bore pressure."""
+    """The patch's share of the wall and the plastic zone's, in the same measure, against the
+    bore pressure.
+
+    The patch's share is of the wall's section area (2D: the quarter annulus of the plane-strain
+    cylinder or the sphere's meridian section; 3D: of the octant's volume); the plastic zone
+    a ≤ r ≤ c covers (c² − a²)/(b² − a²) of that area in 2D, (c³ − a³)/(b³ − a³) of the volume
+    in 3D, so the two curves compare (the patch must stay above the plastic zone).
+    """
     import matplotlib
 
     matplotlib.use("Agg")
@@ -138,13 +183,19 @@ def plot_patch_size(result: PressureVesselResult, path: str) -> None:
 
     h = result.history
     p = np.array(h["pressure"]) / 1e6
-    fig, ax = plt.subplots(figsize=(6, 4))
-    ax.step(p, h["patch_fraction"], where="post", label="patch (share of the wall)")
     a, b = result.config["inner"], result.config["outer"]
-    front = (np.array(h["plastic_radius"]) - a) / (b - a)
-    ax.plot(p, front, "o-", label="plastic front (share of the wall thickness)")
+    dim = int(result.config.get("dim", 2))
+    measure = "volume" if dim == 3 else "section area"
+    c = np.clip(np.array(h["plastic_radius"], dtype=float), a, b)
+    plastic = (c**dim - a**dim) / (b**dim - a**dim)
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.step(p, h["patch_fraction"], where="post", label="J2 patch")
+    ax.plot(p, plastic, "o-", label="plastic zone a ≤ r ≤ c")
     ax.set_xlabel("bore pressure (MPa)")
+    ax.set_ylabel(f"share of the wall's {measure}")
     ax.set_ylim(0.0, 1.05)
+    ax.set_title(f"adaptive patch: {len(result.adaptations)} growths, plastic front c "
+                 f"{c[-1] * 1e3:.4g} mm at {p[-1]:.4g} MPa", fontsize=10)  # fmt: skip
     ax.legend()
     fig.tight_layout()
     fig.savefig(path, dpi=120)

@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ...io import JsonResult
+from ..adaptive_options import ADAPTATIONS_UNIT
 
 __all__ = ["HISTORY_KEYS", "JSON_KEYS", "UNITS", "PressureVesselResult"]
 
@@ -29,7 +30,7 @@ UNITS = {
     "newton_iterations": "1",
     "residuals": "1",
     "reference": "",
-    "adaptations": "",
+    "adaptations": ADAPTATIONS_UNIT,
     "max_coarse_yield_ratio": "1",
     "final": "Pa (pressure), m (radius, displacements)",
     "history": "Pa (pressure), m (radius, displacements), 1 (iterations, residuals)",
@@ -118,6 +119,7 @@ class PressureVesselResult(JsonResult):
             f"{h['outer_displacement'][-1] * 1e6:.3f} µm; {len(its)} steps, Newton "
             f"{sum(its)} iterations (max {max(its, default=0)}), {self.wall_time_s:.1f} s"
             + self._against_hill()
+            + self._growths()
             + (
                 f"; WARNING: the coarse model outside the patch reached "
                 f"{self.max_coarse_yield_ratio:.2f} σy (the plastic zone outgrew the patch)"
@@ -125,6 +127,13 @@ class PressureVesselResult(JsonResult):
                 else ""
             )
         )
+
+    def _growths(self) -> str:
+        """An adaptive run's growths and the largest coarse σ_vm/σy (as the plate says)."""
+        if not self.config.get("adaptive"):
+            return ""
+        return (f"; the patch grew {len(self.adaptations)} times to {self.patch_fraction:.3f} "
+                f"of the wall, coarse σ_vm/σy ≤ {self.max_coarse_yield_ratio:.3f}")  # fmt: skip
 
     def _against_hill(self) -> str:
         ref, h = self.reference, self.history

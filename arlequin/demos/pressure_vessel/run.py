@@ -6,7 +6,6 @@ import logging
 import time
 import warnings
 from collections.abc import Callable
-from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -15,6 +14,7 @@ import numpy as np
 from ...contract import CoarseYieldWarning, SimulationError
 from ...io import QuasiStaticRunWriter, ResultsFolder, read_checkpoint, write_checkpoint
 from ...solvers import solve_quasi_static
+from ..adaptive_options import fixed_patch
 from .hill import (
     cylinder_first_yield,
     cylinder_limit_load,
@@ -138,7 +138,7 @@ def _first_yield(config: PressureVesselConfig, setup: VesselSetup) -> float:
 
     two_rings = config.inner + 2.0 * config.coarse
     if config.adaptive and two_rings < config.outer - 0.5 * config.coarse:  # a ring outside
-        probe = replace(config, adaptive=False, patch_outer=two_rings)
+        probe = fixed_patch(config, patch_outer=two_rings)
         return _first_yield(probe, build(probe))
 
     solver = QuasiStaticSolver(setup.problem, load=1e-3, steps=1)
@@ -248,7 +248,7 @@ def _listeners(config, setup, folder, recorder, first_yield, progress, restore) 
                                       replay=replay)  # fmt: skip
         listeners.append(writer)
         if setup.adapt is not None:
-            listeners.append(AdaptationPictures(folder, setup))
+            listeners.append(AdaptationPictures(folder, setup, recorder.history))
             # no checkpoint (the grown problem is not in it): results.json after every step,
             # so that a hard stop keeps the history of every converged step on disk
             listeners.append(lambda solver: folder.add_results(_so_far(recorder, setup)))
@@ -313,11 +313,17 @@ def resume(out: str, progress: Callable[[float], None] | None = None) -> Pressur
 
 
 def _patch_fraction(meshes: Any) -> float:
-    """The patch's share of the wall's area (1 for mono)."""
+    """The patch's share of the wall's area (of its volume for a solid mesh; 1 for mono)."""
     return 1.0 if meshes.patch is None else _area(meshes.patch) / _area(meshes.coarse)
 
 
 def _area(mesh: Any) -> float:
+    """The mesh's area (m²), its volume (m³) for a solid mesh (the hexahedra's corners are
+    not those of a polygon: scikit-fem's cell measure)."""
+    if mesh.p.shape[0] == 3:
+        import skfem
+
+        return float(skfem.CellBasis(mesh, mesh.elem()).dx.sum())
     p = mesh.p[:, mesh.t]  # (2, 4, n): a quadrilateral's area by the shoelace formula
     x, y = p[0], p[1]
     return float(0.5 * np.abs(np.sum(x * np.roll(y, -1, axis=0) - y * np.roll(x, -1, axis=0),
