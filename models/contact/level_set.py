@@ -247,15 +247,20 @@ class _ContactConstraint:
             np.zeros(m),
         )
 
-    def _trial(self, state, t, dt, u, v, active) -> ContactTrial:
+    def _trial(self, state, t, dt, u, v, statuses) -> ContactTrial:
+        """The step's trial; ``statuses(vn0, gap_pred)`` gives its first active statuses and
+        its S_d, both (m,) bool, from the start-of-step [[v_n]] and the predicted gap (one
+        trial object a step, not a copy for S_d)."""
         geo = self._geometry_from(state, u)
         vn0 = geo.rows @ v
         m = self.pair.n_points
+        gap_pred = geo.gap + dt * vn0
+        active, s_d = statuses(vn0, gap_pred)
         return ContactTrial(
-            active=active(geo, vn0), matrix=self._make_b(geo.rows), rhs=np.zeros(m),
+            active=active, matrix=self._make_b(geo.rows), rhs=np.zeros(m),
             changed=False, iterations=0, t=float(t), dt=float(dt), geometry=geo,
-            gap_start=geo.gap.copy(), vn_start=vn0, gap_pred=geo.gap + dt * vn0,
-            s_d=np.zeros(m, dtype=bool), s_v=np.zeros(m, dtype=bool),
+            gap_start=geo.gap.copy(), vn_start=vn0, gap_pred=gap_pred,
+            s_d=s_d, s_v=np.zeros(m, dtype=bool),
             used=np.zeros(m, dtype=bool), lam=np.zeros(m), vn=vn0, u_start=u,
         )  # fmt: skip
 
@@ -396,12 +401,11 @@ class LevelSetContact(_ContactConstraint):
         guess: persistent contacts and newly closed approaching points."""
         was = state.active
 
-        def guess(geo, vn0):
-            return ((geo.gap + dt * vn0 >= 0.0) | was) & (was | (vn0 > 0.0))
+        def guess(vn0, gap_pred):
+            s_d = (gap_pred >= 0.0) | was
+            return s_d & (was | (vn0 > 0.0)), s_d
 
-        trial = self._trial(state, t, dt, u, v, guess)
-        s_d = (trial.gap_pred >= 0.0) | was
-        return replace(trial, s_d=s_d)
+        return self._trial(state, t, dt, u, v, guess)
 
     def update_status(
         self, trial: ContactTrial, u: np.ndarray, v: np.ndarray, multipliers: np.ndarray
@@ -480,7 +484,11 @@ class SignoriniContact(_ContactConstraint):
     ) -> ContactTrial:
         """Rows at u, right-hand side ``B u^{n+1} = −W (G u^n − d_n(u^n))`` (the linearised
         ``d_n(u^{n+1}) = 0``); the statuses start from the last step's."""
-        trial = self._trial(state, t, dt, u, v, lambda geo, vn0: state.active.copy())
+
+        def first(vn0, gap_pred):  # the last step's statuses; S_d is not used here
+            return state.active.copy(), np.zeros(self.pair.n_points, dtype=bool)
+
+        trial = self._trial(state, t, dt, u, v, first)
         rhs = -self.pair.weights * (trial.geometry.rows @ u - trial.geometry.gap)
         return replace(trial, rhs=rhs)
 
