@@ -53,9 +53,11 @@ Units are SI throughout (m, kg, s, Pa, N, J).
 
 from __future__ import annotations
 
+import copy
 from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
+import scipy.sparse as sp
 
 __all__ = [
     "CAPABILITIES",
@@ -76,11 +78,14 @@ __all__ = [
     "UnilateralConstraint",
     "capabilities",
     "check_protocol",
+    "csr_pattern",
+    "csr_with_data",
     "is_linear",
     "is_unilateral",
     "node_dofs",
     "put_cells",
     "require",
+    "same_pattern",
     "take_cells",
 ]
 
@@ -524,3 +529,52 @@ def node_dofs(nodes: np.ndarray, n_components: int, components=None, offset: int
     if comps.size and (comps.min() < 0 or comps.max() >= n_components):
         raise ValueError(f"components must lie in [0, {n_components}), got {comps.tolist()}")
     return offset + n_components * nodes[None, :] + comps[:, None]
+
+
+def csr_pattern(indices: np.ndarray, indptr: np.ndarray, shape: tuple[int, int]) -> sp.csr_matrix:
+    """A CSR template of rows on a fixed pattern, for :func:`csr_with_data`.
+
+    Its index arrays are read-only and shared by every matrix made from it: a consumer that
+    sorts or prunes a matrix's arrays in place raises instead of changing the others, and
+    consumers key their caches on the arrays' identity (:func:`same_pattern`).
+
+    Parameters
+    ----------
+    indices : ndarray of int, shape (nnz,)
+        Column of each entry, sorted within each row, no duplicates.
+    indptr : ndarray of int, shape (m + 1,)
+        Row pointers.
+    shape : tuple of int
+        (m, n).
+
+    Returns
+    -------
+    csr_matrix, shape (m, n)
+        The template (zero entries).
+    """
+    template = sp.csr_matrix((np.zeros(indices.size), indices, indptr), shape=shape)
+    template.indices.flags.writeable = False
+    template.indptr.flags.writeable = False
+    # sorted without duplicates by construction: flags set, so no consumer sorts or sums
+    template.has_sorted_indices = True
+    template.has_canonical_format = True
+    return template
+
+
+def csr_with_data(template: sp.csr_matrix, data: np.ndarray) -> sp.csr_matrix:
+    """A new CSR matrix on the pattern of ``template`` (:func:`csr_pattern`) with the entries
+    ``data`` (nnz,), not copied (the caller gives a new array: earlier matrices, which states
+    may keep, stay as they were): a shallow copy of the template, 3.5 µs against 17 µs for
+    scipy's constructor and its index checks (several matrices a step on a deforming contact).
+    """
+    out = copy.copy(template)
+    out.data = data
+    return out
+
+
+def same_pattern(a: sp.csr_matrix, b: sp.csr_matrix) -> bool:
+    """Whether CSR matrices ``a`` and ``b`` share their read-only index arrays (both made by
+    :func:`csr_with_data` from one :func:`csr_pattern` template): the same pattern, known
+    without comparing the arrays; False for writable index arrays (they could have changed)."""
+    return (a.indices is b.indices and a.indptr is b.indptr and a.shape == b.shape
+            and not b.indices.flags.writeable and not b.indptr.flags.writeable)  # fmt: skip

@@ -206,3 +206,36 @@ def test_invalid_parameters():
     with pytest.raises(ValueError, match="on_failure"):
         LevelSetContact(con.pair, kappa=1.0, on_failure="ignore")
     assert sp.issparse(con.matrix()) and con.matrix().shape == (1, system.n_dofs)
+
+
+def test_rows_on_a_kept_pattern_equal_scipy_constructions():
+    # csr_with_data against scipy's constructor (exact: the same arrays), the template's index
+    # arrays read-only and shared, and stack_active's pattern path against a fresh stacking
+    from arlequin.contract import csr_pattern, csr_with_data, same_pattern
+    from arlequin.solvers.rows import stack_active
+
+    rng = np.random.default_rng(3)
+    m, w, n = 5, 4, 40
+    cols = np.sort(rng.choice(n, (m, w), replace=False), axis=1)
+    indices, indptr = cols.ravel().astype(np.int32), np.arange(0, m * w + 1, w, dtype=np.int32)
+    template = csr_pattern(indices, indptr, (m, n))
+    a, b = (csr_with_data(template, rng.standard_normal(m * w)) for _ in range(2))
+    ref = sp.csr_matrix((a.data, indices, indptr), shape=(m, n))
+    assert np.array_equal(a.toarray(), ref.toarray()) and a.format == "csr"
+    assert same_pattern(a, b) and not same_pattern(a, ref)
+    with pytest.raises(ValueError):
+        a.indices[0] = 1  # shared by every matrix of the pattern: never changed in place
+
+    class Trial:
+        def __init__(self, matrix, active):
+            self.matrix, self.active, self.rhs = matrix, active, np.zeros(m)
+
+    active = np.array([True, False, True, True, False])
+    cache: dict = {}
+    first, _, _ = stack_active([Trial(a, active)], n, cache)
+    second, _, idx = stack_active([Trial(b, active)], n, cache)  # the kept pattern
+    fresh, _, _ = stack_active([Trial(b, active)], n)
+    assert same_pattern(first, second)
+    for arr in ("data", "indices", "indptr"):
+        assert np.array_equal(getattr(second, arr), getattr(fresh, arr))
+    assert np.array_equal(second.toarray(), b.toarray()[idx[0]])

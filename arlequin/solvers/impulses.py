@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from ..contract import ConstraintError
+from ..contract import ConstraintError, same_pattern
 from .linalg import dense_cho_factor, dense_cho_solve, factor_checked, factor_rows
 
 __all__ = ["ImpulseSolver"]
@@ -44,6 +44,7 @@ class ImpulseSolver:
         # the last active rows' arrays, their factor and the rows object they came from
         self._last: tuple[tuple, Any, Any] | None = None
         self._eq_t_rows: tuple | None = None  # _shared_part's last slice of Bᵀ
+        self._pattern: tuple | None = None  # the last active rows and their pattern's arrays
         self._eq_mask = np.zeros(inv_mass.size, dtype=bool)
         if self.m_e:
             self._eq_mask[rows.cols] = True
@@ -131,7 +132,7 @@ class ImpulseSolver:
                 d_e = self._free_diag[e_rows]
 
                 def build_decoupled():
-                    schur = _dense_gram(g_a, minv)
+                    schur = _dense_gram(g_a, minv, self._pattern_of(g_a))
                     if e_rows.size:
                         schur -= (s_ae_e / d_e) @ s_ae_e.T
                     return self._cholesky(schur, m_a)
@@ -147,7 +148,7 @@ class ImpulseSolver:
         if m_a <= self._DENSE_SCHUR:
 
             def build_schur():
-                schur = _dense_gram(g_a, minv)
+                schur = _dense_gram(g_a, minv, self._pattern_of(g_a))
                 # only the active rows that share a dof with the equality rows have a non-zero
                 # column in (B M⁻¹ G_Aᵀ): solve for those alone (a few near a symmetry axis)
                 coupled = np.nonzero(np.diff(s_ae.indptr))[0]
@@ -184,18 +185,38 @@ class ImpulseSolver:
                 f"({m_a} active rows)"
             ) from exc
 
+    def _pattern_of(self, g_a: sp.csr_matrix) -> dict:
+        """Arrays that depend on the pattern of the active rows G_A alone (their columns, the
+        row of each entry, ...), kept for the last pattern: a deforming contact's rows are new
+        at every step but on the same pattern (the same read-only index arrays,
+        :func:`~arlequin.contract.same_pattern`) while its points keep their facets."""
+        last = self._pattern
+        if last is not None and (last[0] is g_a or same_pattern(last[0], g_a)):
+            return last[1]
+        m = g_a.shape[0]
+        cols, pos = np.unique(g_a.indices, return_inverse=True)
+        arrays = {"cols": cols, "pos": pos, "row": np.repeat(np.arange(m), np.diff(g_a.indptr))}
+        self._pattern = (g_a, arrays)
+        return arrays
+
     def _shared_part(self, g_a: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray]:
         """(the equality rows e that share a dof with the active rows, S_AE[:, e] dense
         (m_A, len(e))): G_A M⁻¹ on the shared dofs (a few) times those rows of Bᵀ."""
-        shared = self._eq_mask[g_a.indices]
+        pat = self._pattern_of(g_a)
         m_a = g_a.shape[0]
-        if not shared.any():
+        if "shared" not in pat:
+            shared = self._eq_mask[g_a.indices]
+            if shared.any():
+                idx = g_a.indices[shared]
+                sh, pos = np.unique(idx, return_inverse=True)
+                pat["shared"] = (shared, idx, sh, (pat["row"][shared], pos))
+            else:
+                pat["shared"] = None
+        if pat["shared"] is None:
             return np.zeros(0, dtype=np.int64), np.zeros((m_a, 0))
-        idx = g_a.indices[shared]
-        sh, pos = np.unique(idx, return_inverse=True)
+        shared, idx, sh, at = pat["shared"]
         g = np.zeros((m_a, sh.size))
-        np.add.at(g, (np.repeat(np.arange(m_a), np.diff(g_a.indptr))[shared], pos),
-                  g_a.data[shared] * self.inv_mass[idx])  # fmt: skip
+        np.add.at(g, at, g_a.data[shared] * self.inv_mass[idx])
         # Bᵀ's rows on those dofs, dense on the equality rows they touch: the same few (the
         # axis under the contact) step after step
         cached = self._eq_t_rows
@@ -223,14 +244,14 @@ class ImpulseSolver:
         return (part @ self._eq_t[cols]).tocsr()
 
 
-def _dense_gram(g: sp.csr_matrix, minv: np.ndarray) -> np.ndarray:
+def _dense_gram(g: sp.csr_matrix, minv: np.ndarray, pattern: dict) -> np.ndarray:
     """G M⁻¹ Gᵀ (m, m) of a few sparse rows, dense: the rows scattered on the columns they
     touch, one matrix product (scipy's sparse product and its conversion cost more, every
-    step of a deformable contact)."""
-    cols, pos = np.unique(g.indices, return_inverse=True)
+    step of a deformable contact); ``pattern``: :meth:`ImpulseSolver._pattern_of` of G."""
+    cols, pos = pattern["cols"], pattern["pos"]
     m = g.shape[0]
     dense = np.zeros((m, cols.size))
-    dense[np.repeat(np.arange(m), np.diff(g.indptr)), pos] = g.data
+    dense[pattern["row"], pos] = g.data
     return (dense * minv[cols]) @ dense.T
 
 

@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
+from ..contract import csr_pattern, csr_with_data, same_pattern
 from ..problem.system import LinearConstraint
 from .linalg import factor_checked
 from .operators import SystemOperators
@@ -79,10 +80,31 @@ def stack_active(trials: Sequence, n: int, cache: dict | None = None):
         return cache["g_a"], np.concatenate(rhs), idx
     mats = [tr.matrix if getattr(tr.matrix, "format", None) == "csr" else
             sp.csr_matrix(tr.matrix) for tr in trials]  # fmt: skip
-    g_a = _stack_rows(mats, idx, n)
+    # new matrices on the same patterns (index arrays, shared while a deforming contact's
+    # points keep their facets: csr_pattern) with the same active rows: the stacked rows'
+    # pattern and the gathers kept, only the entries taken (no scipy constructor a step)
+    pattern_key = tuple((id(m.indices), id(m.indptr), a.tobytes())
+                        for m, a in zip(mats, (tr.active for tr in trials)))  # fmt: skip
+    pattern = cache.get("pattern") if cache is not None else None
+    if pattern is not None and pattern[0] == pattern_key:
+        g_a = csr_with_data(
+            pattern[1], np.concatenate([m.data[p] for m, p in zip(mats, pattern[2])])
+        )
+    else:
+        g_a, pos = _stack_rows(mats, idx, n)
+        if cache is not None:
+            # the index arrays are kept alive with the key so that their ids cannot be reused;
+            # a template only for read-only index arrays (csr_pattern's: never changed)
+            shared = all(not m.indices.flags.writeable and not m.indptr.flags.writeable
+                         for m in mats)  # fmt: skip
+            cache["pattern"] = None
+            if shared:
+                template = csr_pattern(g_a.indices, g_a.indptr, g_a.shape)
+                cache["pattern"] = (pattern_key, template, pos,
+                                    [(m.indices, m.indptr) for m in mats])  # fmt: skip
+                g_a = csr_with_data(template, g_a.data)
     if cache is not None:
         # the matrices are kept alive with the key so that their ids cannot be reused
-        cache.clear()
         cache.update(key=key, g_a=g_a, matrices=[tr.matrix for tr in trials])
     return g_a, np.concatenate(rhs), idx
 
@@ -91,8 +113,8 @@ def _stack_rows(mats: Sequence[sp.csr_matrix], idx: Sequence[np.ndarray], n: int
     """``sp.vstack([m[i] for m, i in zip(mats, idx)], format="csr")``, the same arrays, from
     the CSR arrays in a few vectorised gathers: scipy's row indexing and stacking took twice as
     long (0.14 against 0.07 ms a step of the ball impact, whose deformable pair's rows change
-    every step)."""
-    data, indices, counts = [], [], []
+    every step). Returns it and the positions of its entries in each matrix's arrays."""
+    data, indices, counts, positions = [], [], [], []
     for mat, act in zip(mats, idx):
         start = mat.indptr[act]
         cnt = mat.indptr[act + 1] - start
@@ -102,15 +124,17 @@ def _stack_rows(mats: Sequence[sp.csr_matrix], idx: Sequence[np.ndarray], n: int
         data.append(mat.data[pos])
         indices.append(mat.indices[pos])
         counts.append(cnt)
+        positions.append(pos)
     cnt = np.concatenate(counts)
     indptr = np.zeros(cnt.size + 1, dtype=np.int64)
     np.cumsum(cnt, out=indptr[1:])
     index_dtype = np.int32 if max(n, int(indptr[-1])) < np.iinfo(np.int32).max else np.int64
-    return sp.csr_matrix(
+    g_a = sp.csr_matrix(
         (np.concatenate(data), np.concatenate(indices).astype(index_dtype, copy=False),
          indptr.astype(index_dtype, copy=False)),
         shape=(cnt.size, n),
     )  # fmt: skip
+    return g_a, positions
 
 
 def scatter_active(values: np.ndarray, idx: Sequence[np.ndarray], sizes: Sequence[int]):
@@ -169,8 +193,10 @@ def unilateral_block_powers(
     if g.shape[0] == 0:
         return [np.zeros(nb) for _ in xs]
     # the touched dofs of the last rows (the same object while the active rows are: most
-    # steps of a Taylor bar), as transposed() keeps its transpose
-    if _TOUCHED[0] is not g:
+    # steps of a Taylor bar), as transposed() keeps its transpose, or of their pattern (the
+    # same read-only index arrays: csr_pattern's, a deforming contact's new rows each step)
+    last = _TOUCHED[0]
+    if not (last is g or (last is not None and same_pattern(last, g))):
         cols, inv = np.unique(g.indices, return_inverse=True)
         _TOUCHED[0], _TOUCHED[1] = g, (cols, inv, np.repeat(np.arange(g.shape[0]),
                                                             np.diff(g.indptr)))  # fmt: skip

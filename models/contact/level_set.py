@@ -76,7 +76,7 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from arlequin.contract import SimulationError
+from arlequin.contract import SimulationError, same_pattern
 
 from .geometry import (
     ContactGeometry,
@@ -84,6 +84,8 @@ from .geometry import (
     ContactSurface,
     DeformableContactPair,
     RigidContactPair,
+    csr_pattern,
+    csr_with_data,
 )
 from .obstacles import LevelSetObstacle, Obstacle, PlaneObstacle, SphereObstacle
 from .records import ContactHistory, ContactRecord, ContactState, ContactTrial
@@ -168,6 +170,7 @@ class _ContactConstraint:
         self.update_geometry = bool(update_geometry)
         self._u0 = np.zeros(pair.n_dofs)
         self._b_cache: tuple[sp.csr_matrix, sp.csr_matrix] | None = None
+        self._b_pattern: tuple | None = None  # a G, its rows' −w, its zeros, B's template
         self._geo0 = pair.geometry(self._u0)
 
     # rows
@@ -181,16 +184,26 @@ class _ContactConstraint:
             return cached[1]
         # −W G: each row's entries scaled (a sparse product per step cost a tenth of a step),
         # the zeros (a flat master's tangential components) dropped as eliminate_zeros does,
-        # from the arrays: with scipy's copy and eliminate_zeros it cost 21 µs a step, 15 now
+        # from the arrays: with scipy's copy and eliminate_zeros it cost 21 µs a step, 15 then
         gc = g if getattr(g, "format", None) == "csr" else sp.csr_matrix(g)
-        data = gc.data * np.repeat(-self.pair.weights, np.diff(gc.indptr))
+        # the pattern of B for G's pattern (its index arrays, shared while the points keep
+        # their facets) and those zeros: kept with its template, so that B's rows share their
+        # index arrays too (csr_pattern) and no scipy constructor runs while it holds
+        pat = self._b_pattern
+        same = pat is not None and same_pattern(pat[0], gc)
+        w = pat[1] if same else np.repeat(-self.pair.weights, np.diff(gc.indptr))
+        data = gc.data * w
         keep = data != 0.0
-        if keep.all():
-            indices, indptr = gc.indices.copy(), gc.indptr.copy()
-        else:
-            kept = np.concatenate([[0], np.cumsum(keep)]).astype(gc.indptr.dtype)
-            data, indices, indptr = data[keep], gc.indices[keep], kept[gc.indptr]
-        b = sp.csr_matrix((data, indices, indptr), shape=gc.shape)
+        every = bool(keep.all())
+        if not (same and np.array_equal(pat[2], keep)):
+            if every:
+                indices, indptr = gc.indices, gc.indptr
+            else:
+                kept = np.concatenate([[0], np.cumsum(keep)]).astype(gc.indptr.dtype)
+                indices, indptr = gc.indices[keep], kept[gc.indptr]
+            pat = (gc, w, keep, csr_pattern(indices.copy(), indptr.copy(), gc.shape))
+            self._b_pattern = pat
+        b = csr_with_data(pat[3], data if every else data[keep])
         self._b_cache = (g, b)
         return b
 
@@ -234,15 +247,20 @@ class _ContactConstraint:
             np.zeros(m),
         )
 
-    def _trial(self, state, t, dt, u, v, active) -> ContactTrial:
+    def _trial(self, state, t, dt, u, v, statuses) -> ContactTrial:
+        """The step's trial; ``statuses(vn0, gap_pred)`` gives its first active statuses and
+        its S_d, both (m,) bool, from the start-of-step [[v_n]] and the predicted gap (one
+        trial object a step, not a copy for S_d)."""
         geo = self._geometry_from(state, u)
         vn0 = geo.rows @ v
         m = self.pair.n_points
+        gap_pred = geo.gap + dt * vn0
+        active, s_d = statuses(vn0, gap_pred)
         return ContactTrial(
-            active=active(geo, vn0), matrix=self._make_b(geo.rows), rhs=np.zeros(m),
+            active=active, matrix=self._make_b(geo.rows), rhs=np.zeros(m),
             changed=False, iterations=0, t=float(t), dt=float(dt), geometry=geo,
-            gap_start=geo.gap.copy(), vn_start=vn0, gap_pred=geo.gap + dt * vn0,
-            s_d=np.zeros(m, dtype=bool), s_v=np.zeros(m, dtype=bool),
+            gap_start=geo.gap.copy(), vn_start=vn0, gap_pred=gap_pred,
+            s_d=s_d, s_v=np.zeros(m, dtype=bool),
             used=np.zeros(m, dtype=bool), lam=np.zeros(m), vn=vn0, u_start=u,
         )  # fmt: skip
 
@@ -383,12 +401,11 @@ class LevelSetContact(_ContactConstraint):
         guess: persistent contacts and newly closed approaching points."""
         was = state.active
 
-        def guess(geo, vn0):
-            return ((geo.gap + dt * vn0 >= 0.0) | was) & (was | (vn0 > 0.0))
+        def guess(vn0, gap_pred):
+            s_d = (gap_pred >= 0.0) | was
+            return s_d & (was | (vn0 > 0.0)), s_d
 
-        trial = self._trial(state, t, dt, u, v, guess)
-        s_d = (trial.gap_pred >= 0.0) | was
-        return replace(trial, s_d=s_d)
+        return self._trial(state, t, dt, u, v, guess)
 
     def update_status(
         self, trial: ContactTrial, u: np.ndarray, v: np.ndarray, multipliers: np.ndarray
@@ -467,7 +484,11 @@ class SignoriniContact(_ContactConstraint):
     ) -> ContactTrial:
         """Rows at u, right-hand side ``B u^{n+1} = −W (G u^n − d_n(u^n))`` (the linearised
         ``d_n(u^{n+1}) = 0``); the statuses start from the last step's."""
-        trial = self._trial(state, t, dt, u, v, lambda geo, vn0: state.active.copy())
+
+        def first(vn0, gap_pred):  # the last step's statuses; S_d is not used here
+            return state.active.copy(), np.zeros(self.pair.n_points, dtype=bool)
+
+        trial = self._trial(state, t, dt, u, v, first)
         rhs = -self.pair.weights * (trial.geometry.rows @ u - trial.geometry.gap)
         return replace(trial, rhs=rhs)
 
