@@ -11,6 +11,7 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
+from ..problem.adapt import AdaptivePatch
 from .config import check_range, option
 
 __all__ = [
@@ -20,6 +21,7 @@ __all__ = [
     "adapt_threshold_option",
     "adaptive_inputs",
     "adaptive_option",
+    "adaptive_patch",
     "check_adaptive_options",
     "fixed_patch",
     "growth_title",
@@ -117,3 +119,12 @@ def fixed_patch(config: Any, **changes: Any) -> Any:
     an adaptive run makes (its first yield)."""
     defaults = {f.name: f.default for f in dataclasses.fields(config) if f.name in _SETTINGS}
     return dataclasses.replace(config, **{"adaptive": False, **defaults, **changes})
+
+
+def adaptive_patch(config: Any, **options: Any) -> AdaptivePatch:
+    """An :class:`~arlequin.problem.adapt.AdaptivePatch` with the configuration's four
+    settings (β, buffer, spacing, cap) and the demo's own ``options`` (its refinement, model
+    factory, closure, ...)."""
+    return AdaptivePatch(threshold=config.adapt_threshold, buffer=config.adapt_buffer,
+                         every=config.adapt_every, max_fraction=config.max_patch_fraction,
+                         **options)  # fmt: skip

@@ -37,6 +37,7 @@ from ...models import IsotropicElastic, J2Material, LinearElastic
 from ...problem.adapt import AdaptivePatch
 from ...problem.arlequin_problem import ArlequinProblem
 from ...problem.system import Block, BlockTerm, CoupledSystem
+from ..adaptive_options import adaptive_patch
 from .meshes import graded_plate_mesh, hole_nodes, plate_mesh, refine_projected, square_radius
 
 if TYPE_CHECKING:  # annotations only: the configuration runs this module
@@ -261,18 +262,15 @@ def _adaptive_patch(config: PlateWithHoleConfig, coarse: Any, make_j2: Any) -> A
     """The adaptation of the seed patch (the options of ``config``): new cells refined with the
     hole's new nodes on the circle, as the seed."""
     a, levels = config.radius, config.levels
-    return AdaptivePatch(
+    return adaptive_patch(
+        config,
         model_factory=make_j2,
         levels=levels,
         refine=lambda cells: refine_projected(coarse, levels, a, cells=cells),
-        threshold=config.adapt_threshold,
-        buffer=config.adapt_buffer,
         # grow when the plastic zone comes within one coarse cell of the band (a load step
         # moves the front by several fine cells: closer, it would enter the band and the step
         # be computed again)
         band_cells=2**levels,
-        every=config.adapt_every,
-        max_fraction=config.max_patch_fraction,
         closure=fill_notches(coarse),
         # the band's outer half, where α_f < 1/2, yields spuriously where the coarse stress
         # is 0.85 σy (the multipliers' forces on a vanishing fine stiffness): disregarded

@@ -22,6 +22,7 @@ from ...coupling.gluing import Patch
 from ...models import FiniteStrainJ2, IsotropicElastic, J2Material, LinearElastic
 from ...problem.adapt import AdaptivePatch
 from ...problem.arlequin_problem import ArlequinProblem
+from ..adaptive_options import adaptive_patch
 from .meshes import VesselMeshes, refine_projected, vessel_meshes
 
 if TYPE_CHECKING:  # annotations only: the configuration runs this module
@@ -165,18 +166,15 @@ def build(config: PressureVesselConfig) -> VesselSetup:
     adapt = None
     if config.adaptive:
         coarse_mesh, levels = meshes.coarse, meshes.levels
-        adapt = AdaptivePatch(
+        adapt = adaptive_patch(
+            config,
             model_factory=lambda mesh: _plastic_model(config, mesh, kind),
             levels=levels,
             refine=lambda cells: refine_projected(coarse_mesh, levels, (a,), cells),
-            threshold=config.adapt_threshold,
-            buffer=config.adapt_buffer,
             # grow when the plastic zone comes within one coarse ring of the band (a load
             # step moves the front by several fine cells: closer, it would enter the band and
             # the step be computed again)
             band_cells=2**levels,
-            every=config.adapt_every,
-            max_fraction=config.max_patch_fraction,
             closure=_whole_rings(coarse_mesh),
         )
     return VesselSetup(problem, meshes, plastic_block, plastic, kind, outer, inner, blocks, adapt)
