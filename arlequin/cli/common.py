@@ -72,7 +72,7 @@ def add_out(p: argparse.ArgumentParser) -> None:
         "--out",
         metavar="DIR",
         default=None,
-        help="write a results folder: results.json, history.csv, fields/*.xdmf, pictures",
+        help="write a results folder: results.json, CSV histories, fields/*.xdmf, pictures",
     )
 
 
