@@ -26,8 +26,12 @@ def write_checkpoint(path: str | os.PathLike, payload: dict[str, Any]) -> None:
     leaves the previous checkpoint whole)."""
     path = Path(path)
     tmp = path.with_suffix(path.suffix + ".tmp")
-    with open(tmp, "wb") as fh:
-        pickle.dump(payload, fh, protocol=pickle.HIGHEST_PROTOCOL)
+    try:
+        with open(tmp, "wb") as fh:
+            pickle.dump(payload, fh, protocol=pickle.HIGHEST_PROTOCOL)
+    except BaseException:  # an unpicklable payload or an interruption: no partial file left
+        tmp.unlink(missing_ok=True)
+        raise
     os.replace(tmp, path)
 
 
@@ -43,8 +47,9 @@ def read_checkpoint(path: str | os.PathLike) -> dict[str, Any]:
     path = Path(path)
     if not path.is_file():
         raise CheckpointError(
-            f"no checkpoint {str(path)!r}: --resume needs the results folder of an interrupted "
-            "run (--out DIR of that run)"
+            f"no checkpoint {str(path)!r}: nothing to resume (the run completed, or it stopped "
+            "before its first step); --resume needs the results folder of an interrupted run "
+            "(--out DIR of that run)"
         )
     try:
         with open(path, "rb") as fh:

@@ -18,7 +18,7 @@ import pickle
 from pathlib import Path
 from typing import Any
 
-from ...io import read_series
+from ...io import read_checkpoint, read_series, write_checkpoint
 
 __all__ = ["CHECKPOINT", "CheckpointWriter", "load_checkpoint", "read_frames"]
 
@@ -69,16 +69,12 @@ class CheckpointWriter:
             "taylor": self.taylor.state(),
             "multipliers": None if self.multipliers is None else self.multipliers.state(),
         }  # fmt: skip
-        tmp = self.path.with_suffix(".tmp")
         try:
-            with open(tmp, "wb") as fh:
-                pickle.dump(data, fh, protocol=pickle.HIGHEST_PROTOCOL)
+            write_checkpoint(self.path, data)
         except (pickle.PicklingError, TypeError, AttributeError) as exc:
             self.enabled = False  # e.g. user weights given as lambdas: no resume
-            tmp.unlink(missing_ok=True)
             logger.warning("checkpoints disabled: the run's inputs cannot be saved (%s)", exc)
             return
-        os.replace(tmp, self.path)
         self.written += 1
 
     def resume_from(self, ckpt: dict[str, Any], frames: dict[str, list]) -> None:
@@ -109,16 +105,7 @@ def load_checkpoint(out: str | os.PathLike | None, config: dict | None) -> dict[
     if out is None:
         raise ValueError("resume=True needs out=DIR, the results folder of the interrupted run")
     path = Path(out) / CHECKPOINT
-    if not path.is_file():
-        raise ValueError(
-            f"no checkpoint in {str(out)!r}: nothing to resume (the run completed, or it stopped "
-            "before its first checkpoint)"
-        )
-    try:
-        with open(path, "rb") as fh:
-            data = pickle.load(fh)
-    except Exception as exc:  # a truncated or foreign file
-        raise ValueError(f"cannot read the checkpoint {str(path)!r}: {exc}") from exc
+    data = read_checkpoint(path)  # CheckpointError (a ValueError): none, or unreadable
     if not isinstance(data, dict) or data.get("format") != _FORMAT:
         raise ValueError(f"{str(path)!r} is not a Taylor bar checkpoint of this version")
     if config is not None and data["config"] != config:
