@@ -246,3 +246,41 @@ def test_warm_up_compiles_every_signature_the_taylor_bar_uses(geometry, model, n
     before = list(kernel.signatures)
     run_taylor_bar(model=model, elements_radial=n, geometry=geometry, t_end=3e-8)
     assert kernel.signatures == before
+
+
+@pytest.mark.parametrize("dim, nen", [(2, 4), (3, 8)])
+def test_cell_force_assembly_is_bincount_bit_for_bit(dim, nen):
+    # the kernels' nodal assembly replaced np.bincount over the (component, node, cell)
+    # arrays: the same additions in the same order, so the same floats (not merely close)
+    from arlequin.models.plasticity.j2_kernel import assemble_cell_forces
+
+    rng = np.random.default_rng(3)
+    ne, n_nodes = 57, 40
+    nodes = rng.integers(0, n_nodes, size=(ne, nen))  # shared nodes, in any order
+    cell_dofs = np.stack([dim * nodes + i for i in range(dim)], axis=-1)  # (ne, nen, dim)
+    fe = rng.standard_normal((dim, nen, ne)) * 10.0 ** rng.integers(-8, 8, size=(dim, nen, ne))
+    flags = np.zeros(ne, dtype=np.int64)
+    f = np.full(dim * n_nodes + 3, np.nan)  # overwritten, trailing dofs of no cell included
+    assert assemble_cell_forces(cell_dofs, fe, flags, f) == 0
+    by_component = np.transpose(cell_dofs, (2, 1, 0))  # the model's (dim, nen, ne) layout
+    expected = np.bincount(by_component.ravel(), weights=fe.ravel(), minlength=f.size)
+    assert np.array_equal(f, expected)
+    flags[[4, 30]] = (1, 2)
+    assert assemble_cell_forces(cell_dofs, fe, flags, f) == 2
+
+
+def test_compiled_critical_step_is_the_numpy_estimate_bit_for_bit():
+    # the numba backend's critical step computes the cell sizes in one compiled pass: the same
+    # operations as Q1Kinematics.cell_sizes (the numpy backend's), so the same float, on a
+    # distorted mesh and on the reference one
+    mesh = skfem.MeshQuad.init_tensor(np.linspace(0, 3.2e-3, 7), np.linspace(0, 10e-3, 19))
+    compiled = FiniteStrainJ2(mesh, COPPER, backend="numba")
+    reference = FiniteStrainJ2(mesh, COPPER, backend="numpy")
+    rng = np.random.default_rng(5)
+    for scale in (0.0, 2e-5, 1e-4):
+        u = rng.standard_normal(compiled.n_dofs) * scale
+        assert compiled.critical_time_step(u) == reference.critical_time_step(u)
+    crushed = np.zeros(compiled.n_dofs)
+    crushed[compiled.nodal_dofs()[1]] = -0.5 * mesh.p[1]  # half as tall: a smaller step
+    assert compiled.critical_time_step(crushed) == reference.critical_time_step(crushed)
+    assert compiled.critical_time_step(crushed) < compiled.critical_time_step(0.0 * crushed)

@@ -149,6 +149,7 @@ class FiniteStrainJ2(CellStates):
         area = self.kin.dv0.sum(axis=1) / self._measure_factor()
         self._h0 = np.sqrt(area) if dim == 2 else np.cbrt(area)
         self._critical_ratio: np.ndarray | None = None
+        self._size_arrays: tuple | None = None  # the compiled critical step's mesh arrays
         self._kernel_static: tuple | None = None  # contiguous inputs and scratch of the kernel
         self._ones: np.ndarray | None = None
         self._alpha_of: tuple | None = None  # (read-only weight, its checked broadcast)
@@ -430,7 +431,7 @@ class FiniteStrainJ2(CellStates):
             c(state.plastic_work), c(state.viscous_work), c(state.jacobian), visc, h0,
             s_h, s_g, s_u, *out,
         )  # fmt: skip
-        return self._gathered(out)
+        return self._gathered(out, dofs)
 
     def _internal_force_numba_3d(self, u, state, alpha, dt):
         from .j2_kernel import run_kernel
@@ -456,7 +457,7 @@ class FiniteStrainJ2(CellStates):
             c(state.plastic_work), c(state.viscous_work), c(state.jacobian), visc, h0,
             s_h, s_g, s_m, *out,
         )  # fmt: skip
-        return self._gathered(out)
+        return self._gathered(out, dofs)
 
     def _kernel_constants(self, alpha: np.ndarray) -> tuple:
         """The kernels' weight (n_elems, n_qp) and material constants K, G (Pa), law code and
@@ -510,11 +511,14 @@ class FiniteStrainJ2(CellStates):
                                        + [(ne, nq)] * 3)  # fmt: skip
         return [fe, *arrays, flags]
 
-    def _gathered(self, out: list[np.ndarray]):
-        """The kernel's outputs as (nodal force, PlasticState); flagged cells raise."""
-        kin = self.kin
+    def _gathered(self, out: list[np.ndarray], cell_dofs: np.ndarray):
+        """The kernel's outputs as (nodal force, PlasticState); flagged cells raise.
+        ``cell_dofs`` (ne, nen, dim): the kernel's dofs of each cell's nodes."""
+        from .j2_kernel import assemble_cell_forces
+
         fe, cp_inv, eqps, tau, J, wp, wv, flags = out
-        if np.any(flags):
+        f = np.empty(self.kin.n_dofs)
+        if assemble_cell_forces(cell_dofs, fe, flags, f):
             bad = np.nonzero(flags)[0]
             cell = int(bad[0])
             if flags[cell] == 1:
@@ -522,7 +526,6 @@ class FiniteStrainJ2(CellStates):
                     f"inverted or degenerate cell {cell}: det F <= 0 ({bad.size} such cells)"
                 )
             raise StateError(f"J2 return map not converged in cell {cell}")
-        f = np.bincount(kin.cell_dofs.ravel(), weights=fe.ravel(), minlength=kin.n_dofs)
         return f, PlasticState(cp_inv, eqps, tau, J, wp, wv)
 
     # ------------------------------------------------------------------ post-processing
@@ -582,6 +585,16 @@ class FiniteStrainJ2(CellStates):
         if self._critical_ratio is None:
             per_cell = element_critical_step(self.elastic, self.elastic.basis, per_cell=True)
             self._critical_ratio = per_cell * cd / self.kin.cell_sizes(self.mesh.p)
+        if self.backend == "numba" and self.dim == 2:
+            from .j2_kernel import min_scaled_cell_size
+
+            if self._size_arrays is None:  # one type for the compiled loop whatever the mesh's
+                c = np.ascontiguousarray
+                self._size_arrays = (c(self.mesh.p, dtype=float), c(self.mesh.t, dtype=np.int64),
+                                     c(self.kin.dofs, dtype=np.int64))  # fmt: skip
+            u = self._checked_displacement(u)
+            h_min = min_scaled_cell_size(*self._size_arrays, u, self._critical_ratio)
+            return float(h_min / cd)
         h = self.kin.cell_sizes(self.current_coordinates(u))
         return float(np.min(self._critical_ratio * h) / cd)
 

@@ -21,7 +21,7 @@ import math
 import numba as nb
 import numpy as np
 
-from .j2_kernel import SQRT23, _flow, _plastic_multiplier
+from .j2_kernel import SQRT23, _flow, _plastic_multiplier, assemble_cell_forces
 
 __all__ = ["solid_j2_kernel", "solid_scratch", "warm_up_solid"]
 
@@ -341,3 +341,4 @@ def warm_up_solid() -> None:
         np.array([1.0, 0.0, 0.0, 0.0, 0.0, 0.0]), 0.0, cp, zeros, zeros, zeros, ones,
         np.zeros(4), np.ones(ne), *solid_scratch(nq, nen), *out,
     )  # fmt: skip
+    assemble_cell_forces(dofs, out[0], out[-1], np.zeros(3 * nen))
