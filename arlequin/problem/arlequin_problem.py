@@ -359,7 +359,9 @@ class ArlequinProblem:
                 f += vec if amp is None else float(amp(t)) * vec
             return f
 
-        return CoupledSystem(blocks, constraints, load_fn)
+        # unloaded: no load function, so that an explicit step does not build and test a
+        # vector of zeros at every step
+        return CoupledSystem(blocks, constraints, load_fn if parts else None)
 
     def field_layout(self) -> FieldLayout:
         """What a results folder shows of this problem: each block's mesh with its cell-mean

@@ -129,6 +129,7 @@ class CentralDifference(Integrator):
         self._impulse_failed = False
         self._f_applied: np.ndarray | None = None
         self.constraint_time = 0.0
+        self._work_buffers: tuple[np.ndarray, np.ndarray] | None = None
         super().__init__(system, dt, **kwargs)
 
     def _equality_rows(self, constraints) -> EqualityRows:
@@ -462,7 +463,15 @@ class CentralDifference(Integrator):
             self._powers(v_half)  # fmt: skip
         # commit the step's kinematics and model states
         if not self.ops.linear:
-            self._w_internal += self.ops.block_dots(u_new - self.u, 0.5 * (self._f_int + f_int))
+            # Δu and the mean force in two kept buffers (read by block_dots only): the same
+            # numbers as u_new − u and 0.5 (f_old + f_new), without two new n-vectors a step
+            bufs = self._work_buffers
+            if bufs is None or bufs[0].shape != u_new.shape:
+                bufs = self._work_buffers = (np.empty_like(u_new), np.empty_like(u_new))
+            du = np.subtract(u_new, self.u, out=bufs[0])
+            f_mean = np.add(self._f_int, f_int, out=bufs[1])
+            f_mean *= 0.5
+            self._w_internal += self.ops.block_dots(du, f_mean)
         self.u = u_new
         self.a = a_new
         self.states = trial
