@@ -540,20 +540,31 @@ class FiniteStrainJ2(CellStates):
         return float(np.sum(alpha * self.kin.dv0 * psi))
 
     def stored_energy_of_state(self, state: PlasticState, weight: WeightLike = None) -> float:
-        """Elastic stored energy Σ w₀ ψ (J) from a state's own Kirchhoff stress: for the Hencky
-        law τ = K ln J 1 + 2G dev ε_e, so ψ = (tr τ)²/(18 K) + ‖dev τ‖²/(4 G).
-
-        The same as :meth:`stored_energy` at the displacement the state was evaluated at (to
-        round-off), without recomputing the kinematics: a product per quadrature point.
+        """Elastic stored energy Σ w₀ ψ (J) of a state (:meth:`elastic_energy_of_state`), the
+        member of the energy contract that pairs it with :meth:`plastic_dissipation`.
 
         Raises
         ------
         ValueError
-            With bulk viscosity, whose pressure the state's τ includes.
+            With bulk viscosity: its work is dissipated too (:meth:`viscous_dissipation`), so
+            the pair would not close an energy balance; callers that account for it take
+            :meth:`elastic_energy_of_state`.
         """
         if self.bulk_viscosity:
-            raise ValueError("stored_energy_of_state: the state's Kirchhoff stress includes the "
-                             "bulk viscosity's pressure; use stored_energy(u, state)")  # fmt: skip
+            raise ValueError("stored_energy_of_state: with bulk viscosity the dissipation is not "
+                             "plastic_dissipation alone (the viscous work too); the elastic "
+                             "energy alone is elastic_energy_of_state(state)")  # fmt: skip
+        return self.elastic_energy_of_state(state, weight)
+
+    def elastic_energy_of_state(self, state: PlasticState, weight: WeightLike = None) -> float:
+        """Elastic energy Σ w₀ ψ (J) from a state's own Kirchhoff stress: for the Hencky law
+        τ = K ln J 1 + 2G dev ε_e, so ψ = (tr τ)²/(18 K) + ‖dev τ‖²/(4 G).
+
+        The same as :meth:`stored_energy` at the displacement the state was evaluated at (to
+        round-off), without recomputing the kinematics: a product per quadrature point. The
+        state's τ is the material stress (the bulk viscosity's pressure is not stored in it),
+        so this holds with bulk viscosity too.
+        """
         alpha = self.elastic.weight_at_quadrature(weight)
         tau = state.kirchhoff
         tr = tau[0, 0] + tau[1, 1] + tau[2, 2]

@@ -367,14 +367,11 @@ class ImpactBodies:
         part = self.plastic_part()
         if part is None:
             return 0.0, 0.0
-        model, block, index, weight, transfer = part
+        model, block, index, weight, _ = part
         ub = u[self.system.dofmap[block].slice]
         state = states[block][index]
-        if model.bulk_viscosity:
-            uj = ub if transfer is None else transfer @ ub
-            elastic = model.stored_energy(uj, state, weight)
-        else:  # the committed state is the one at u: its own τ gives ψ (no kinematics)
-            elastic = model.stored_energy_of_state(state, weight)
+        # the committed state is the one at u: its own τ gives ψ (no kinematics)
+        elastic = model.elastic_energy_of_state(state, weight)
         if self.zoned is not None:
             k = self.system.block(block).terms[0].model.stiffness_matrix
             elastic += 0.5 * float(ub @ (k @ ub))

@@ -174,9 +174,8 @@ class MonoBar:
         """Stored (elastic), plastic and viscous energies and the coupling work (J); ``e`` is
         ``integ.energies()`` (unused on one mesh)."""
         state = self.fine_state(integ)
-        u = integ.u
         return {
-            "elastic": self.model.stored_energy(u, state),
+            "elastic": self.model.elastic_energy_of_state(state),
             "plastic_dissipation": self.model.plastic_dissipation(state),
             "viscous_dissipation": self.model.viscous_dissipation(state),
             "coupling_work": 0.0,
@@ -223,10 +222,9 @@ class ArlequinBarView:
         """Weighted energies of both models and the net work of the coupling forces (J);
         ``e`` is ``integ.energies()``."""
         state = self.fine_state(integ)
-        uf = integ.u[self._f]
         alpha = self.coupling.alpha_fine
         return {
-            "elastic": e["strain"]["coarse"] + self.model.stored_energy(uf, state, alpha),
+            "elastic": e["strain"]["coarse"] + self.model.elastic_energy_of_state(state, alpha),
             "plastic_dissipation": self.model.plastic_dissipation(state, alpha),
             "viscous_dissipation": self.model.viscous_dissipation(state, alpha),
             "coupling_work": float(sum(e["coupling_work"].values())),

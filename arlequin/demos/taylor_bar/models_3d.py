@@ -183,7 +183,7 @@ class MonoBar3D(_Quarter):
         """Stored (elastic), plastic and viscous energies of the quarter (J)."""
         state = self.fine_state(integ)
         return {
-            "elastic": self.model.stored_energy(integ.u, state),
+            "elastic": self.model.elastic_energy_of_state(state),
             "plastic_dissipation": self.model.plastic_dissipation(state),
             "viscous_dissipation": self.model.viscous_dissipation(state),
             "coupling_work": 0.0,
