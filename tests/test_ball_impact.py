@@ -387,3 +387,24 @@ def test_a_bad_value_is_the_same_error_from_the_command_line_and_python(monkeypa
         capsys.readouterr()
         assert main(["ball-impact", "--quiet", *argv]) == 2
         assert f"error: {python.value}" in capsys.readouterr().err, argv
+
+
+def test_plastic_frames_carry_the_block_patch_plastic_strain(tmp_path):
+    # the results folder's block patch series: ε̄p and the von Mises stress (cell means of the
+    # J2 states) beside α in every frame, with their units in results.json; the last frame's
+    # largest cell mean is at most the run's largest ε̄p at a quadrature point, and positive
+    import meshio
+
+    r = run_ball_impact(regime="plastic", block_radius=0.02, block_height=0.02,
+                        out=tmp_path / "run", **ROUGH)  # fmt: skip
+    meta = json.loads((tmp_path / "run" / "results.json").read_text())
+    assert meta["field_units"]["plastic_strain"] == "1"
+    assert meta["field_units"]["von_mises"] == "Pa"
+    with meshio.xdmf.TimeSeriesReader(str(tmp_path / "run" / "fields" / "block.patch.xdmf")) as f:
+        f.read_points_cells()
+        assert f.num_steps == 10
+        _, _, cells = f.read_data(f.num_steps - 1)
+    eqps = np.asarray(cells["plastic_strain"][0])
+    assert 0.0 < eqps.max() <= r.max_plastic_strain
+    assert np.asarray(cells["von_mises"][0]).max() > 0.0
+    assert "alpha" in cells

@@ -42,6 +42,11 @@ class DynamicRunWriter:
         :func:`~arlequin.solvers.solve` as ``t_eval`` too (the records are then only there).
     prefix : str
         Prefix of the file names (several runs in one folder).
+    cell_data : callable, optional
+        ``cell_data(integrator) -> {block name: {field name: (n_cells,) array}}``: more cell
+        fields of a frame (the models' own, e.g. ε̄p and the von Mises stress of a J2 patch).
+    units : mapping, optional
+        Units of those fields (recorded in results.json).
     """
 
     def __init__(
@@ -51,20 +56,23 @@ class DynamicRunWriter:
         layout: FieldLayout | None = None,
         frame_times: Sequence[float] | None = None,
         prefix: str = "",
+        cell_data: Any = None,
+        units: dict[str, str] | None = None,
     ) -> None:
         self.system = system
+        self.cell_data = cell_data
         self.layout = FieldLayout.of_system(system) if layout is None else layout
         names = [b.name for b in system.blocks]
         self.columns = ["t", "dt", "step", "energy", "balance"] + [
             f"{k}:{n}" for k in _ENERGIES for n in names
         ]
-        units = {c: "J" for c in self.columns}
-        units.update({"t": "s", "dt": "s", "step": "1"})
-        self.history = folder.history(self.columns, units, name=f"{prefix}history")
+        columns_units = {c: "J" for c in self.columns}
+        columns_units.update({"t": "s", "dt": "s", "step": "1"})
+        self.history = folder.history(self.columns, columns_units, name=f"{prefix}history")
         self.series = {
             bf.name: folder.series(f"{prefix}{bf.name}", bf.mesh) for bf in self.layout.blocks
         }
-        folder.meta.setdefault("field_units", {}).update(self.layout.units)
+        folder.meta.setdefault("field_units", {}).update({**self.layout.units, **(units or {})})
         self.frame_times = None if frame_times is None else np.sort(np.asarray(frame_times))
         self._folder, self._prefix = folder, prefix
         self._meshes = {bf.name: bf.mesh for bf in self.layout.blocks}
@@ -91,7 +99,8 @@ class DynamicRunWriter:
                 row[f"{k}:{name}"] = val
         self.history.append(row)
         if self._due(integ.t, integ.step_size):
-            self.write_frame(integ.t, integ.u, integ.v, integ.multipliers)
+            extra = self.cell_data(integ) if self.cell_data is not None else None
+            self.write_frame(integ.t, integ.u, integ.v, integ.multipliers, extra)
         self._row_times.append(float(integ.t))
         self._row_next.append(self._next)
 
@@ -137,13 +146,14 @@ class DynamicRunWriter:
             due = True
         return due
 
-    def write_frame(self, t, u, v=None, multipliers=None) -> None:
-        """One frame of every block at time t (s)."""
+    def write_frame(self, t, u, v=None, multipliers=None, cell_data=None) -> None:
+        """One frame of every block at time t (s); ``cell_data``: {block name: {field name:
+        (n_cells,) array}} added to the blocks' cell fields."""
         for name, (file, mesh) in self._pending_series.items():
             self.series[name] = self._folder.series(file, mesh)
         self._pending_series = {}
         for name, (point, cell) in self.layout.frame(self.system.dofmap, u, v, multipliers).items():
-            self.series[name].write(t, point, cell)
+            self.series[name].write(t, point, {**cell, **(cell_data or {}).get(name, {})})
         self.frames_written.append(float(t))
 
 

@@ -155,6 +155,23 @@ def _integrator(inputs: ResolvedInputs, bodies: ImpactBodies) -> tuple[str, dict
     return "explicit-mts", options
 
 
+def _plastic_fields(bodies: ImpactBodies) -> tuple[Any, dict[str, str] | None]:
+    """The frames' cell fields of the block's J2 patch (cell means of ε̄p and of the von Mises
+    stress) and their units, or (None, None) in the elastic regime and when the J2 law lives
+    on a mesh of its own (``mono-zoned``: not the block's series)."""
+    part = bodies.plastic_part()
+    if part is None or part[4] is not None:
+        return None, None
+    _, block, index, _, _ = part
+
+    def cell_data(integ: Any) -> dict[str, dict[str, np.ndarray]]:
+        state = integ.states[block][index]
+        return {block: {"plastic_strain": state.eqps.mean(axis=1),
+                        "von_mises": state.von_mises.mean(axis=1)}}  # fmt: skip
+
+    return cell_data, {"plastic_strain": "1", "von_mises": "Pa"}
+
+
 def _time_loop(inputs: ResolvedInputs, bodies: ImpactBodies, listeners: list[Any],
                folder: ResultsFolder | None, t_end: float,
                adapt: Any = None) -> tuple[Any, float]:  # fmt: skip
@@ -162,7 +179,9 @@ def _time_loop(inputs: ResolvedInputs, bodies: ImpactBodies, listeners: list[Any
     called after every step (the :class:`ImpactRecorder` first), ``adapt`` the adaptive block
     patch, if any."""
     frames = np.linspace(0.0, t_end, 11)[1:]
-    writers = ([DynamicRunWriter(folder, bodies.system, layout=bodies.layout, frame_times=frames)]
+    cell_data, units = _plastic_fields(bodies)
+    writers = ([DynamicRunWriter(folder, bodies.system, layout=bodies.layout, frame_times=frames,
+                                 cell_data=cell_data, units=units)]
                if folder else [])  # fmt: skip
     integrator, options = _integrator(inputs, bodies)
     tic = time.perf_counter()
