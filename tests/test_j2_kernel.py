@@ -284,3 +284,23 @@ def test_compiled_critical_step_is_the_numpy_estimate_bit_for_bit():
     crushed[compiled.nodal_dofs()[1]] = -0.5 * mesh.p[1]  # half as tall: a smaller step
     assert compiled.critical_time_step(crushed) == reference.critical_time_step(crushed)
     assert compiled.critical_time_step(crushed) < compiled.critical_time_step(0.0 * crushed)
+
+
+@pytest.mark.parametrize("kind", ["axisymmetric", "plane_strain"])
+def test_planar_states_keep_zero_out_of_plane_shear_through_pool_reuse(kind):
+    # the planar kernel leaves C_p⁻¹'s and τ's out-of-plane shear unwritten: the model's pool
+    # hands out fresh arrays of zeros or arrays only this kernel wrote. Ten evaluations (the
+    # states dropped, so their arrays are written over), each against the numpy path: every
+    # component as there (zeros included), the shear exactly zero
+    numpy_model, numba_model = pair(kind, "linear")
+    state_np = state_nb = numba_model.initial_state()
+    for k in range(10):
+        u = random_u(numba_model, 0.05, seed=40 + k, compress=0.02 * k)
+        ref = numpy_model.internal_force(u, state_np)
+        out = numba_model.internal_force(u, state_nb)
+        assert_same(ref, out, f"{kind} evaluation {k}")
+        for field in (out[1].cp_inv, out[1].kirchhoff):
+            for i, j in ((0, 2), (2, 0), (1, 2), (2, 1)):
+                assert not np.any(field[i, j])
+        if k % 3 == 2:  # commit now and then: a state held while others are recycled
+            state_np, state_nb = ref[1], out[1]

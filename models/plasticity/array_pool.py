@@ -42,12 +42,15 @@ class ArrayPool:
         self._sets: list[list[np.ndarray]] = []
 
     def take(self, shapes: Sequence[tuple[int, ...]]) -> list[np.ndarray]:
-        """A set of uninitialised arrays of these shapes that nothing else references."""
+        """A set of arrays of these shapes that nothing else references: a set handed out
+        before (holding what its user wrote), or fresh arrays of zeros (``calloc``'s pages,
+        zeroed as they are first touched: a writer may leave entries that stay zero unwritten,
+        e.g. the out-of-plane shear of planar states)."""
         shapes = [tuple(s) for s in shapes]
         for arrays in self._sets:
             if [a.shape for a in arrays] == shapes and _max_refs(arrays) <= _FREE_REFS:
                 return arrays
-        arrays = [np.empty(s) for s in shapes]
+        arrays = [np.zeros(s) for s in shapes]
         if len(self._sets) < self.size:
             self._sets.append(arrays)
         return arrays

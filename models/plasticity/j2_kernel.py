@@ -232,7 +232,9 @@ def planar_j2_kernel(
     (n_threads, nq, 6), scratch_g (n_threads, nq, nen, 3), scratch_u (n_threads, 4, nen).
     Outputs (overwritten): fe (2, nen, ne) cell forces, cp_new, tau_out (3, 3, ne, nq),
     eqps_new, j_out, wp_new, wv_new (ne, nq), flags (ne,): 1 inverted cell, 2 return map not
-    converged.
+    converged. The out-of-plane shear components of cp_new and tau_out ([0, 2], [2, 0], [1, 2],
+    [2, 1]) are not written: they must hold zeros (the model's arrays come from a pool whose
+    fresh arrays are zeros and which only this kernel writes; eight stores per point less).
     """
     ne = grad.shape[0]
     # Q1 cells with 2 × 2 Gauss points: fixed trip counts, so that the compiler unrolls the
@@ -446,19 +448,11 @@ def planar_j2_kernel(
                 cp_new[1, 0, e, q] = cp_inv[1, 0, e, q]
                 cp_new[1, 1, e, q] = cp_inv[1, 1, e, q]
                 cp_new[2, 2, e, q] = cp_inv[2, 2, e, q]
-            cp_new[0, 2, e, q] = 0.0
-            cp_new[2, 0, e, q] = 0.0
-            cp_new[1, 2, e, q] = 0.0
-            cp_new[2, 1, e, q] = 0.0
             tau_out[0, 0, e, q] = tau00
             tau_out[1, 1, e, q] = tau11
             tau_out[0, 1, e, q] = tau01
             tau_out[1, 0, e, q] = tau01
             tau_out[2, 2, e, q] = tau22
-            tau_out[0, 2, e, q] = 0.0
-            tau_out[2, 0, e, q] = 0.0
-            tau_out[1, 2, e, q] = 0.0
-            tau_out[2, 1, e, q] = 0.0
             j_out[e, q] = jq
             wv_new[e, q] = wv[e, q] + qv * (jbar_old - jbar)
             # forces: material stress plus the viscous pressure
