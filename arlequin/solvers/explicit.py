@@ -130,6 +130,7 @@ class CentralDifference(Integrator):
         self._f_applied: np.ndarray | None = None
         self.constraint_time = 0.0
         self._work_buffers: tuple[np.ndarray, np.ndarray] | None = None
+        self._neg_inv_mass: tuple[np.ndarray, np.ndarray] | None = None
         super().__init__(system, dt, **kwargs)
 
     def _equality_rows(self, constraints) -> EqualityRows:
@@ -284,14 +285,18 @@ class CentralDifference(Integrator):
             if rows.m:
                 v_new[rows.cols] -= self._minv_cols * (rows.matrix_cols_t @ lam_e)
             if g_a.shape[0]:
-                v_new -= minv * transposed_times(g_a, lam_a)
+                push = transposed_times(g_a, lam_a)
+                push *= minv  # M⁻¹ Gᵀλ in Gᵀλ's own new array (commutative: the same bits)
+                v_new -= push
             if timer is not None:
                 timer.linear_algebra += timer.clock() - tic
             fulls = self._full_multipliers(lam_a / dt_bar, idx)
             if f_app is not None:
                 fulls = [f if a is None else f + a for f, a in zip(fulls, applied)]
             self._f_applied = f_app
-            trials, changed = self._update_statuses(trials, u + dt * v_new, v_new, fulls)
+            u_end = dt * v_new
+            u_end += u  # u + Δt v in one new array (commutative: the same bits)
+            trials, changed = self._update_statuses(trials, u_end, v_new, fulls)
             if not changed:
                 converged = True
                 break
@@ -328,7 +333,15 @@ class CentralDifference(Integrator):
             )  # fmt: skip
         self._v_next = v_next
         share = dt_prev / (dt_prev + dt)
-        self.v = v_minus + share * (v_next - v_minus) if share else v_minus.copy()
+        if share:
+            # v⁻ + share (v⁺ − v⁻) in one new array (the same operations, the last two in
+            # commuted order: the same bits)
+            v = v_next - v_minus
+            v *= share
+            v += v_minus
+            self.v = v
+        else:
+            self.v = v_minus.copy()
         self._lam_e = lam_e
         self._lam_a = lam_a
         self._g_a = g_a
@@ -351,7 +364,9 @@ class CentralDifference(Integrator):
 
     def _kick(self, v_minus: np.ndarray, dt_bar: float) -> np.ndarray:
         """The free prediction v* = v^{n−½} + Δt̄_n a^n (a new array)."""
-        return v_minus + dt_bar * self.a
+        v_star = dt_bar * self.a
+        v_star += v_minus  # commutative: the bits of v⁻ + Δt̄ a, one array fewer
+        return v_star
 
     def _kinetic(self) -> np.ndarray:
         """The scheme's kinetic energy per block (J): ½ ṽ^{n−½}·M v^{n+½}, with ṽ^{n−½} the
@@ -406,7 +421,15 @@ class CentralDifference(Integrator):
 
     def _acceleration(self, f_int: np.ndarray, f_ext: np.ndarray | None) -> np.ndarray:
         minv = self.ops.inv_mass
-        return -minv * f_int if f_ext is None else minv * (f_ext - f_int)
+        if f_ext is None:
+            # (−M⁻¹) f_int with −M⁻¹ kept (negation is exact): one array a step fewer
+            cached = self._neg_inv_mass
+            if cached is None or cached[0] is not minv:
+                cached = self._neg_inv_mass = (minv, -minv)
+            return cached[1] * f_int
+        a = f_ext - f_int
+        a *= minv
+        return a
 
     # ------------------------------------------------------------------ initial state
     def _initialize(self) -> None:
@@ -450,7 +473,8 @@ class CentralDifference(Integrator):
         dt = self.dt
         t_new = self._end_time()
         v_half = self._v_next
-        u_new = self.u + dt * v_half
+        u_new = dt * v_half
+        u_new += self.u  # u + Δt v^{n+½}, one new array (commutative: the same bits)
         f_int, f_ext, trial = self._forces(u_new, t_new, dt)
         f_damp = self._damping_force(v_half)  # −C v^{n+1/2}: the damping force at t_{n+1}
         a_new = self._acceleration(f_int if f_damp is None else f_int + f_damp, f_ext)
