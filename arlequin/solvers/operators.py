@@ -247,7 +247,14 @@ class SystemOperators:
                 timer.kernel += timer.clock() - tic
             trial[b.name][ti] = new_state
             p = term.transfer
-            f[b.dofs] += term.sign * (ft if p is None else p.T @ ft)
+            ft = ft if p is None else p.T @ ft
+            # ±ft added or subtracted in place (a + (−b) is a − b: the same floats, no temporary)
+            if term.sign == 1:
+                f[b.dofs] += ft
+            elif term.sign == -1:
+                f[b.dofs] -= ft
+            else:
+                f[b.dofs] += term.sign * ft
             if tangent:
                 if self.tangent_kind == "consistent":
                     if getattr(term.model, "uses_time_step", False):  # rates: the same dt
