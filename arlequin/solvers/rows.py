@@ -67,17 +67,19 @@ def stack_active(trials: Sequence, n: int, cache: dict | None = None):
     idx : list of ndarray of int
         The active row indices of each constraint.
     """
-    rhs, idx = [], []
-    for tr in trials:
-        act = np.nonzero(tr.active)[0]
-        idx.append(act)
-        rhs.append(np.asarray(tr.rhs, dtype=float)[act])
     if not trials:
-        return sp.csr_matrix((0, n)), np.zeros(0), idx
-    # the same matrices with the same active rows (most steps): the same stacked rows
+        return sp.csr_matrix((0, n)), np.zeros(0), []
+    # the same matrices with the same active rows (most steps): the same stacked rows, the
+    # same active indices, and the same right-hand sides when the trials' are the same arrays
+    # (a velocity-level contact's zeros); the cache keeps what it returns read-only
     key = tuple((id(tr.matrix), tr.active.tobytes()) for tr in trials)
     if cache is not None and cache.get("key") == key:
-        return cache["g_a"], np.concatenate(rhs), idx
+        idx = cache["idx"]
+        if all(tr.rhs is r for tr, r in zip(trials, cache["rhs_of"])):
+            return cache["g_a"], cache["rhs_a"], list(idx)
+        return cache["g_a"], _active_rhs(trials, idx), list(idx)
+    idx = [np.nonzero(tr.active)[0] for tr in trials]
+    rhs_a = _active_rhs(trials, idx)
     mats = [tr.matrix if getattr(tr.matrix, "format", None) == "csr" else
             sp.csr_matrix(tr.matrix) for tr in trials]  # fmt: skip
     # new matrices on the same patterns (index arrays, shared while a deforming contact's
@@ -104,9 +106,19 @@ def stack_active(trials: Sequence, n: int, cache: dict | None = None):
                                     [(m.indices, m.indptr) for m in mats])  # fmt: skip
                 g_a = csr_with_data(template, g_a.data)
     if cache is not None:
-        # the matrices are kept alive with the key so that their ids cannot be reused
-        cache.update(key=key, g_a=g_a, matrices=[tr.matrix for tr in trials])
-    return g_a, np.concatenate(rhs), idx
+        # the matrices and right-hand sides are kept alive with the key so that their ids
+        # cannot be reused
+        for a in (*idx, rhs_a):
+            a.flags.writeable = False
+        cache.update(key=key, g_a=g_a, matrices=[tr.matrix for tr in trials], idx=idx,
+                     rhs_of=[tr.rhs for tr in trials], rhs_a=rhs_a)  # fmt: skip
+        idx = list(idx)
+    return g_a, rhs_a, idx
+
+
+def _active_rhs(trials: Sequence, idx: Sequence[np.ndarray]) -> np.ndarray:
+    """The right-hand sides of the trials' active rows ``idx``, stacked, shape (m_A,)."""
+    return np.concatenate([np.asarray(tr.rhs, dtype=float)[act] for tr, act in zip(trials, idx)])
 
 
 def _stack_rows(mats: Sequence[sp.csr_matrix], idx: Sequence[np.ndarray], n: int):

@@ -186,13 +186,19 @@ class CoulombContact(LevelSetContact):
         """G_t: v ↦ [[v_t]] at the points, shape ((dim − 1) m, n), row j m + k."""
         cached = self._t_cache
         rigid = isinstance(self.pair, RigidContactPair)
-        if rigid and cached is not None and np.array_equal(cached[0], geo.normal):
+        if (
+            rigid
+            and cached is not None
+            and (cached[0] is geo.normal or np.array_equal(cached[0], geo.normal))
+        ):
             return cached[1]  # a rigid pair's rows depend on its normals only
         if geo.jump is None:
             raise ValueError("the contact pair gives no velocity-jump rows (ContactGeometry.jump)")
         t = tangents(geo.normal) * self._frictional[None, None, :]  # (nt, dim, m)
         g = sp.vstack([geo.jump(t[j]) for j in range(t.shape[0])], format="csr")
-        self._t_cache = (geo.normal.copy(), g)
+        # read-only normals (a plane's, the same array every step) are kept as they are
+        n = geo.normal
+        self._t_cache = (n if not n.flags.writeable else n.copy(), g)
         return g
 
     def _stack(self, ntrial: ContactTrial, g_t: sp.csr_matrix) -> sp.csr_matrix:

@@ -70,13 +70,12 @@ Lagrange multiplier, primal–dual active set on ``d_n(u_{n+1}) ≤ 0``).
 from __future__ import annotations
 
 import logging
-from dataclasses import replace
 from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
 
-from arlequin.contract import SimulationError, same_pattern
+from arlequin.contract import SimulationError, csr_pattern, same_pattern
 
 from .geometry import (
     ContactGeometry,
@@ -84,11 +83,10 @@ from .geometry import (
     ContactSurface,
     DeformableContactPair,
     RigidContactPair,
-    csr_pattern,
     csr_with_data,
 )
 from .obstacles import LevelSetObstacle, Obstacle, PlaneObstacle, SphereObstacle
-from .records import ContactHistory, ContactRecord, ContactState, ContactTrial
+from .records import ContactHistory, ContactRecord, ContactState, ContactTrial, build, evolve
 
 __all__ = [
     "ContactConvergenceError",
@@ -171,7 +169,15 @@ class _ContactConstraint:
         self._u0 = np.zeros(pair.n_dofs)
         self._b_cache: tuple[sp.csr_matrix, sp.csr_matrix] | None = None
         self._b_pattern: tuple | None = None  # a G, its rows' −w, its zeros, B's template
+        self._b_cols: tuple | None = None  # a B, the columns it touches, B on those alone
         self._geo0 = pair.geometry(self._u0)
+        self._gdofs = getattr(pair, "geometry_dofs", None)
+        # a trial's fields that start at zero, shared by every trial (read-only: states and
+        # trials are never modified in place; new arrays replace them)
+        m = pair.n_points
+        self._zeros = (np.zeros(m), np.zeros(m, dtype=bool))
+        for a in self._zeros:
+            a.flags.writeable = False
 
     # rows
     @property
@@ -225,11 +231,34 @@ class _ContactConstraint:
         if last is u:
             return state.geometry
         # the geometry depends on the pair's dofs alone: compared there (a few hundred values,
-        # not the whole system's at every step)
-        dofs = getattr(self.pair, "geometry_dofs", None)
-        same = np.array_equal(last, u) if dofs is None or last.shape != u.shape else \
-            np.array_equal(last[dofs], u[dofs])  # fmt: skip
+        # not the whole system's at every step); == and all() as array_equal for equal shapes
+        dofs = self._gdofs
+        if last.shape != u.shape:
+            same = False
+        elif dofs is None:
+            same = bool((last == u).all())
+        else:
+            same = bool((last[dofs] == u[dofs]).all())
         return state.geometry if same else self.geometry(u)
+
+    def _rows_times(self, b: sp.csr_matrix, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """``b @ (x + y)`` (m,) for rows b (m, n) and vectors x, y (n,), the sum taken on the
+        columns b touches only (a full-size sum was most of a commit): the same entries in
+        the same order, so the same numbers bit for bit."""
+        cached = self._b_cols
+        if cached is None or cached[0] is not b:
+            if not same_pattern(b, b):  # writable index arrays: no pattern to key the columns on
+                return b @ (x + y)
+            if cached is not None and same_pattern(cached[0], b):
+                cols, template = cached[1], cached[3]
+            else:  # the columns renumbered in their order: each row's entries keep theirs
+                cols, pos = np.unique(b.indices, return_inverse=True)
+                template = csr_pattern(pos.astype(b.indices.dtype), b.indptr,
+                                       (b.shape[0], cols.size))  # fmt: skip
+            cached = (b, cols, csr_with_data(template, b.data), template)
+            self._b_cols = cached
+        cols = cached[1]
+        return cached[2] @ (x[cols] + y[cols])
 
     def gaps(self, u: np.ndarray) -> np.ndarray:
         """d_n (m) at the collocation points for displacement u, shape (m,)."""
@@ -253,15 +282,15 @@ class _ContactConstraint:
         trial object a step, not a copy for S_d)."""
         geo = self._geometry_from(state, u)
         vn0 = geo.rows @ v
-        m = self.pair.n_points
         gap_pred = geo.gap + dt * vn0
         active, s_d = statuses(vn0, gap_pred)
-        return ContactTrial(
-            active=active, matrix=self._make_b(geo.rows), rhs=np.zeros(m),
+        zero, false = self._zeros
+        # the geometry's gap is never modified: no copy of it for gap_start
+        return build(
+            ContactTrial, active=active, matrix=self._make_b(geo.rows), rhs=zero,
             changed=False, iterations=0, t=float(t), dt=float(dt), geometry=geo,
-            gap_start=geo.gap.copy(), vn_start=vn0, gap_pred=gap_pred,
-            s_d=s_d, s_v=np.zeros(m, dtype=bool),
-            used=np.zeros(m, dtype=bool), lam=np.zeros(m), vn=vn0, u_start=u,
+            gap_start=geo.gap, vn_start=vn0, gap_pred=gap_pred,
+            s_d=s_d, s_v=false, used=false, lam=zero, vn=vn0, u_start=u,
         )  # fmt: skip
 
     def commit(
@@ -296,13 +325,14 @@ class _ContactConstraint:
             if self.on_failure == "raise":
                 raise ContactConvergenceError(msg, 0, t)
             logger.warning(msg)
-        vsum = v_before + v_after
-        work = state.work - 0.5 * float(np.asarray(impulse) @ (trial.matrix @ vsum))
+        work = state.work - 0.5 * float(
+            np.asarray(impulse) @ self._rows_times(trial.matrix, v_before, v_after)
+        )
         # the explicit scheme commits at the configuration its step started from: reuse it
         same = trial.u_start is u or np.array_equal(trial.u_start, u)
         geo_end = trial.geometry if same else self.geometry(u)
-        record = ContactRecord(
-            t=float(t), iterations=trial.iterations, converged=not trial.changed,
+        record = build(
+            ContactRecord, t=float(t), iterations=trial.iterations, converged=not trial.changed,
             active=trial.used, s_d=trial.s_d, s_v=trial.s_v, gap=geo_end.gap,
             gap_start=trial.gap_start, vn_start=trial.vn_start, vn=trial.vn, lam=trial.lam,
             work=work, dt=trial.dt,
@@ -310,15 +340,11 @@ class _ContactConstraint:
         total = np.asarray(impulse, dtype=float)
         if state.impulse is not None:
             total = state.impulse + total
-        return ContactState(
-            trial.used.copy(),
-            work,
-            record,
-            trial.lam.copy(),
-            geo_end,
-            np.array(u, copy=True),
-            total,
-        )
+        # the trial's arrays are the constraint's own (update_status copied the multipliers),
+        # never modified: kept without copies; u is the integrator's, copied
+        return build(ContactState, active=trial.used, work=work, record=record,
+                     multipliers=trial.lam, geometry=geo_end, u_geometry=u.copy(),
+                     impulse=total)  # fmt: skip
 
     def history(self, result: Any) -> ContactHistory:
         """The records of this constraint in a :class:`~arlequin.solvers.DynamicResult`,
@@ -412,14 +438,14 @@ class LevelSetContact(_ContactConstraint):
     ) -> ContactTrial:
         """New active statuses from the trial fields (the indicator fields S_d, S_v at the
         collocation points); whether any changed."""
-        lam = np.asarray(multipliers, dtype=float)
+        lam = np.array(multipliers, dtype=float)  # a copy: the integrator's array
         vn = trial.geometry.rows @ v  # [[v_n]] with the step's rows
-        used = trial.active
+        used = trial.active  # made by this constraint, never modified: kept as it is
         s_v = lam - self.kappa * vn <= 0.0
         new = trial.s_d & s_v
-        return replace(
-            trial, active=new, changed=bool(np.any(new != used)),
-            iterations=trial.iterations + 1, used=used.copy(), lam=lam.copy(), vn=vn, s_v=s_v,
+        return evolve(
+            trial, active=new, changed=bool((new != used).any()),
+            iterations=trial.iterations + 1, used=used, lam=lam, vn=vn, s_v=s_v,
         )  # fmt: skip
 
     def weak_residual(
@@ -490,7 +516,7 @@ class SignoriniContact(_ContactConstraint):
 
         trial = self._trial(state, t, dt, u, v, first)
         rhs = -self.pair.weights * (trial.geometry.rows @ u - trial.geometry.gap)
-        return replace(trial, rhs=rhs)
+        return evolve(trial, rhs=rhs)
 
     def update_status(
         self, trial: ContactTrial, u: np.ndarray, v: np.ndarray, multipliers: np.ndarray
@@ -502,8 +528,8 @@ class SignoriniContact(_ContactConstraint):
         gap = trial.gap_start + g @ (u - trial.u_start)
         used = trial.active
         new = np.where(used, lam <= 0.0, gap > self.gap_tol)
-        return replace(
+        return evolve(
             trial, active=new, changed=bool(np.any(new != used)),
-            iterations=trial.iterations + 1, used=used.copy(), lam=lam.copy(), vn=g @ v,
+            iterations=trial.iterations + 1, used=used, lam=lam.copy(), vn=g @ v,
             s_d=gap > self.gap_tol, s_v=lam <= 0.0,
         )  # fmt: skip
