@@ -85,6 +85,7 @@ from .geometry import (
     RigidContactPair,
     csr_with_data,
 )
+from .kernel import equal_at, level_set_begin, level_set_status, rows_times_sum
 from .obstacles import LevelSetObstacle, Obstacle, PlaneObstacle, SphereObstacle
 from .records import ContactHistory, ContactRecord, ContactState, ContactTrial, build, evolve
 
@@ -137,6 +138,13 @@ def acoustic_impedance(young: float, density: float, poisson: float | None = Non
     return float(np.sqrt(modulus * density))
 
 
+def _compiled(g: Any, x: np.ndarray) -> bool:
+    """Whether the compiled kernels apply to rows g and a vector x: CSR rows of floats and a
+    float vector of their width (else the numpy reference, the same numbers)."""
+    return (getattr(g, "format", None) == "csr" and g.data.dtype == np.float64
+            and x.dtype == np.float64 and x.shape == (g.shape[1],))  # fmt: skip
+
+
 class _ContactConstraint:
     """Shared machinery: the geometry per step, the records, the contact work."""
 
@@ -169,7 +177,6 @@ class _ContactConstraint:
         self._u0 = np.zeros(pair.n_dofs)
         self._b_cache: tuple[sp.csr_matrix, sp.csr_matrix] | None = None
         self._b_pattern: tuple | None = None  # a G, its rows' −w, its zeros, B's template
-        self._b_cols: tuple | None = None  # a B, the columns it touches, B on those alone
         self._geo0 = pair.geometry(self._u0)
         self._gdofs = getattr(pair, "geometry_dofs", None)
         # a trial's fields that start at zero, shared by every trial (read-only: states and
@@ -235,30 +242,11 @@ class _ContactConstraint:
         dofs = self._gdofs
         if last.shape != u.shape:
             same = False
-        elif dofs is None:
-            same = bool((last == u).all())
+        elif dofs is None or last.dtype != np.float64 or u.dtype != np.float64:
+            same = bool((last == u).all() if dofs is None else (last[dofs] == u[dofs]).all())
         else:
-            same = bool((last[dofs] == u[dofs]).all())
+            same = equal_at(last, u, dofs)
         return state.geometry if same else self.geometry(u)
-
-    def _rows_times(self, b: sp.csr_matrix, x: np.ndarray, y: np.ndarray) -> np.ndarray:
-        """``b @ (x + y)`` (m,) for rows b (m, n) and vectors x, y (n,), the sum taken on the
-        columns b touches only (a full-size sum was most of a commit): the same entries in
-        the same order, so the same numbers bit for bit."""
-        cached = self._b_cols
-        if cached is None or cached[0] is not b:
-            if not same_pattern(b, b):  # writable index arrays: no pattern to key the columns on
-                return b @ (x + y)
-            if cached is not None and same_pattern(cached[0], b):
-                cols, template = cached[1], cached[3]
-            else:  # the columns renumbered in their order: each row's entries keep theirs
-                cols, pos = np.unique(b.indices, return_inverse=True)
-                template = csr_pattern(pos.astype(b.indices.dtype), b.indptr,
-                                       (b.shape[0], cols.size))  # fmt: skip
-            cached = (b, cols, csr_with_data(template, b.data), template)
-            self._b_cols = cached
-        cols = cached[1]
-        return cached[2] @ (x[cols] + y[cols])
 
     def gaps(self, u: np.ndarray) -> np.ndarray:
         """d_n (m) at the collocation points for displacement u, shape (m,)."""
@@ -276,14 +264,18 @@ class _ContactConstraint:
             np.zeros(m),
         )
 
-    def _trial(self, state, t, dt, u, v, statuses) -> ContactTrial:
-        """The step's trial; ``statuses(vn0, gap_pred)`` gives its first active statuses and
-        its S_d, both (m,) bool, from the start-of-step [[v_n]] and the predicted gap (one
-        trial object a step, not a copy for S_d)."""
+    def _first_statuses(self, geo: ContactGeometry, v: np.ndarray, dt: float,
+                        was: np.ndarray) -> tuple[np.ndarray, ...]:  # fmt: skip
+        """``(vn0, gap_pred, s_d, active)`` of a step: [[v_n]] (m/s) at its start, the
+        predicted gap (m), S_d and the first active statuses (bool), each (m,), from the
+        geometry at its start, its free velocity v, its size dt (s) and the last statuses."""
+        raise NotImplementedError
+
+    def _trial(self, state, t, dt, u, v) -> ContactTrial:
+        """The step's trial, its first statuses by :meth:`_first_statuses` (one trial object a
+        step, not a copy for S_d)."""
         geo = self._geometry_from(state, u)
-        vn0 = geo.rows @ v
-        gap_pred = geo.gap + dt * vn0
-        active, s_d = statuses(vn0, gap_pred)
+        vn0, gap_pred, s_d, active = self._first_statuses(geo, v, float(dt), state.active)
         zero, false = self._zeros
         # the geometry's gap is never modified: no copy of it for gap_start
         return build(
@@ -325,9 +317,11 @@ class _ContactConstraint:
             if self.on_failure == "raise":
                 raise ContactConvergenceError(msg, 0, t)
             logger.warning(msg)
-        work = state.work - 0.5 * float(
-            np.asarray(impulse) @ self._rows_times(trial.matrix, v_before, v_after)
-        )
+        # B (v_before + v_after) with the sum on B's columns only (a full-size sum was most of
+        # a commit); _make_b's rows are always CSR
+        b = trial.matrix
+        b_vsum = rows_times_sum(b.indptr, b.indices, b.data, v_before, v_after)
+        work = state.work - 0.5 * float(np.asarray(impulse) @ b_vsum)
         # the explicit scheme commits at the configuration its step started from: reuse it
         same = trial.u_start is u or np.array_equal(trial.u_start, u)
         geo_end = trial.geometry if same else self.geometry(u)
@@ -425,13 +419,16 @@ class LevelSetContact(_ContactConstraint):
         """Rows at u; S_d on the predicted end-of-step gap d_n + Δt [[v_n]] (v: the step's free
         velocity), kept at 1 for points active in the last step (their gap is frozen); first
         guess: persistent contacts and newly closed approaching points."""
-        was = state.active
+        return self._trial(state, t, dt, u, v)
 
-        def guess(vn0, gap_pred):
-            s_d = (gap_pred >= 0.0) | was
-            return s_d & (was | (vn0 > 0.0)), s_d
-
-        return self._trial(state, t, dt, u, v, guess)
+    def _first_statuses(self, geo, v, dt, was):
+        g = geo.rows
+        if _compiled(g, v):
+            return level_set_begin(g.indptr, g.indices, g.data, v, geo.gap, dt, was)
+        vn0 = g @ v  # the kernel's reference
+        gap_pred = geo.gap + dt * vn0
+        s_d = (gap_pred >= 0.0) | was
+        return vn0, gap_pred, s_d, s_d & (was | (vn0 > 0.0))
 
     def update_status(
         self, trial: ContactTrial, u: np.ndarray, v: np.ndarray, multipliers: np.ndarray
@@ -439,12 +436,18 @@ class LevelSetContact(_ContactConstraint):
         """New active statuses from the trial fields (the indicator fields S_d, S_v at the
         collocation points); whether any changed."""
         lam = np.array(multipliers, dtype=float)  # a copy: the integrator's array
-        vn = trial.geometry.rows @ v  # [[v_n]] with the step's rows
+        g = trial.geometry.rows  # [[v_n]] with the step's rows
         used = trial.active  # made by this constraint, never modified: kept as it is
-        s_v = lam - self.kappa * vn <= 0.0
-        new = trial.s_d & s_v
+        if _compiled(g, v) and lam.shape == used.shape:
+            vn, s_v, new, changed = level_set_status(g.indptr, g.indices, g.data, v, lam,
+                                                     self.kappa, trial.s_d, used)  # fmt: skip
+        else:  # the kernel's reference
+            vn = g @ v
+            s_v = lam - self.kappa * vn <= 0.0
+            new = trial.s_d & s_v
+            changed = bool((new != used).any())
         return evolve(
-            trial, active=new, changed=bool((new != used).any()),
+            trial, active=new, changed=changed,
             iterations=trial.iterations + 1, used=used, lam=lam, vn=vn, s_v=s_v,
         )  # fmt: skip
 
@@ -510,13 +513,14 @@ class SignoriniContact(_ContactConstraint):
     ) -> ContactTrial:
         """Rows at u, right-hand side ``B u^{n+1} = −W (G u^n − d_n(u^n))`` (the linearised
         ``d_n(u^{n+1}) = 0``); the statuses start from the last step's."""
-
-        def first(vn0, gap_pred):  # the last step's statuses; S_d is not used here
-            return state.active.copy(), np.zeros(self.pair.n_points, dtype=bool)
-
-        trial = self._trial(state, t, dt, u, v, first)
+        trial = self._trial(state, t, dt, u, v)
         rhs = -self.pair.weights * (trial.geometry.rows @ u - trial.geometry.gap)
         return evolve(trial, rhs=rhs)
+
+    def _first_statuses(self, geo, v, dt, was):
+        # the last step's statuses; S_d is not used here
+        vn0 = geo.rows @ v
+        return vn0, geo.gap + dt * vn0, np.zeros(self.pair.n_points, dtype=bool), was.copy()
 
     def update_status(
         self, trial: ContactTrial, u: np.ndarray, v: np.ndarray, multipliers: np.ndarray
