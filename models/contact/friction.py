@@ -43,7 +43,7 @@ explicit integrator (slip tractions are applied forces; ``explicit_only``).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -51,7 +51,7 @@ import scipy.sparse as sp
 
 from .geometry import ContactGeometry, ContactPair, RigidContactPair
 from .level_set import LevelSetContact
-from .records import ContactState, ContactTrial
+from .records import ContactState, ContactTrial, evolve
 
 __all__ = ["CoulombContact", "FrictionState", "FrictionTrial", "tangents"]
 
@@ -260,7 +260,7 @@ class CoulombContact(LevelSetContact):
         changed = (ntrial.changed or bool(np.any(stick != trial.stick))
                    or moved > self.slip_tolerance * max(scale, 1e-300))  # fmt: skip
         applied = np.concatenate([np.zeros(m), applied_t.ravel()])
-        return replace(
+        return evolve(
             trial, active=np.concatenate([ntrial.active, np.tile(stick, nt)]), changed=changed,
             iterations=trial.iterations + 1, applied=applied, normal=ntrial, stick=stick,
             vt=vt,

@@ -138,11 +138,15 @@ def acoustic_impedance(young: float, density: float, poisson: float | None = Non
     return float(np.sqrt(modulus * density))
 
 
-def _compiled(g: Any, x: np.ndarray) -> bool:
+def _compiled(g: Any, x: np.ndarray, last: list) -> bool:
     """Whether the compiled kernels apply to rows g and a vector x: CSR rows of floats and a
-    float vector of their width (else the numpy reference, the same numbers)."""
-    return (getattr(g, "format", None) == "csr" and g.data.dtype == np.float64
-            and x.dtype == np.float64 and x.shape == (g.shape[1],))  # fmt: skip
+    float vector of their width (else the numpy reference, the same numbers). ``last`` keeps
+    the last rows found CSR of floats and their width (a plane's rows: the same every step)."""
+    if last[0] is not g:
+        if not (getattr(g, "format", None) == "csr" and g.data.dtype == np.float64):
+            return False
+        last[0], last[1] = g, (g.shape[1],)
+    return x.dtype == np.float64 and x.shape == last[1]
 
 
 class _ContactConstraint:
@@ -179,6 +183,7 @@ class _ContactConstraint:
         self._b_pattern: tuple | None = None  # a G, its rows' −w, its zeros, B's template
         self._geo0 = pair.geometry(self._u0)
         self._gdofs = getattr(pair, "geometry_dofs", None)
+        self._csr_rows: list = [None, None]  # see _compiled
         # a trial's fields that start at zero, shared by every trial (read-only: states and
         # trials are never modified in place; new arrays replace them)
         m = pair.n_points
@@ -246,7 +251,9 @@ class _ContactConstraint:
             same = bool((last == u).all() if dofs is None else (last[dofs] == u[dofs]).all())
         else:
             same = equal_at(last, u, dofs)
-        return state.geometry if same else self.geometry(u)
+        if same:
+            return state.geometry
+        return self.pair.geometry(u) if self.update_geometry else self.geometry(u)
 
     def gaps(self, u: np.ndarray) -> np.ndarray:
         """d_n (m) at the collocation points for displacement u, shape (m,)."""
@@ -423,7 +430,7 @@ class LevelSetContact(_ContactConstraint):
 
     def _first_statuses(self, geo, v, dt, was):
         g = geo.rows
-        if _compiled(g, v):
+        if _compiled(g, v, self._csr_rows):
             return level_set_begin(g.indptr, g.indices, g.data, v, geo.gap, dt, was)
         vn0 = g @ v  # the kernel's reference
         gap_pred = geo.gap + dt * vn0
@@ -438,7 +445,7 @@ class LevelSetContact(_ContactConstraint):
         lam = np.array(multipliers, dtype=float)  # a copy: the integrator's array
         g = trial.geometry.rows  # [[v_n]] with the step's rows
         used = trial.active  # made by this constraint, never modified: kept as it is
-        if _compiled(g, v) and lam.shape == used.shape:
+        if _compiled(g, v, self._csr_rows) and lam.shape == used.shape:
             vn, s_v, new, changed = level_set_status(g.indptr, g.indices, g.data, v, lam,
                                                      self.kappa, trial.s_d, used)  # fmt: skip
         else:  # the kernel's reference
