@@ -25,6 +25,7 @@ from arlequin.models.contact.kernel import (
     level_set_status,
     rows_times,
     rows_times_sum,
+    scaled_entries,
 )
 from arlequin.models.contact.records import ContactTrial, build, evolve
 from arlequin.solvers.rows import stack_active
@@ -198,3 +199,20 @@ def test_stack_active_kept_patterns_equal_a_fresh_stacking():
         again = stack_active([tr], n, cache)  # the same trial: the same objects
         assert again[0] is g_a and again[1] is rhs_a and not rhs_a.flags.writeable
     assert len(cache["patterns"]) == 3
+
+
+@pytest.mark.parametrize("zeros", [False, True])
+def test_scaled_entries_equal_numpy(zeros):
+    # reference: the numpy lines of _make_b (scaled entries, their zeros dropped)
+    rng = np.random.default_rng(5)
+    data = rng.standard_normal(50)
+    if zeros:
+        data[[3, 7, 20]] = [0.0, -0.0, 0.0]
+    w = -rng.random(50)
+    ref = data * w
+    keep_ref = ref != 0.0
+    for before in (keep_ref, ~keep_ref, keep_ref[:-1]):
+        out, keep, same, every = scaled_entries(data, w, before)
+        assert same_bytes(out, ref[keep_ref]) and same_bytes(keep, keep_ref)
+        assert every == bool(keep_ref.all())
+        assert same == (before.shape == keep_ref.shape and np.array_equal(before, keep_ref))

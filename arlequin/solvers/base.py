@@ -412,11 +412,10 @@ class Integrator:
         g_a, rhs_a, idx = stack_active(trials, self.ops.n, cache)
         if not idx:
             return g_a, rhs_a, idx, np.zeros(0, dtype=bool)
-        # the rows' levels for the same active rows (stack_active's key: the same object while
-        # they are) kept, read-only
-        key = cache["key"]
+        # the rows' levels for the same numbers of active rows per constraint kept, read-only
+        key = tuple(a.size for a in idx)
         levels = cache.get("levels")
-        if levels is not None and levels[0] is key:
+        if levels is not None and levels[0] == key:
             return g_a, rhs_a, idx, levels[1]
         disp = np.concatenate(
             [np.full(a.size, c.level == "displacement") for c, a in zip(self.unilateral, idx)]

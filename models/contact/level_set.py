@@ -85,7 +85,13 @@ from .geometry import (
     RigidContactPair,
     csr_with_data,
 )
-from .kernel import equal_at, level_set_begin, level_set_status, rows_times_sum
+from .kernel import (
+    equal_at,
+    level_set_begin,
+    level_set_status,
+    rows_times_sum,
+    scaled_entries,
+)
 from .obstacles import LevelSetObstacle, Obstacle, PlaneObstacle, SphereObstacle
 from .records import ContactHistory, ContactRecord, ContactState, ContactTrial, build, evolve
 
@@ -210,10 +216,17 @@ class _ContactConstraint:
         pat = self._b_pattern
         same = pat is not None and same_pattern(pat[0], gc)
         w = pat[1] if same else np.repeat(-self.pair.weights, np.diff(gc.indptr))
-        data = gc.data * w
-        keep = data != 0.0
-        every = bool(keep.all())
-        if not (same and np.array_equal(pat[2], keep)):
+        if gc.data.dtype == np.float64 and same:
+            # one call: the entries scaled, the kept ones, whether the zeros are where they
+            # were (the same numbers as the numpy lines below, their reference)
+            kept_data, keep, same, every = scaled_entries(gc.data, w, pat[2])
+        else:
+            data = gc.data * w
+            keep = data != 0.0
+            every = bool(keep.all())
+            same = same and np.array_equal(pat[2], keep)
+            kept_data = data if every else data[keep]
+        if not same:
             if every:
                 indices, indptr = gc.indices, gc.indptr
             else:
@@ -221,7 +234,7 @@ class _ContactConstraint:
                 indices, indptr = gc.indices[keep], kept[gc.indptr]
             pat = (gc, w, keep, csr_pattern(indices.copy(), indptr.copy(), gc.shape))
             self._b_pattern = pat
-        b = csr_with_data(pat[3], data if every else data[keep])
+        b = csr_with_data(pat[3], kept_data)
         self._b_cache = (g, b)
         return b
 
