@@ -65,6 +65,13 @@ configuration).
 
 :class:`SignoriniContact` is the displacement-level baseline (Newmark + Signorini with a
 Lagrange multiplier, primal–dual active set on ``d_n(u_{n+1}) ≤ 0``).
+
+The per-step arithmetic (the rows' products, the statuses) runs in the compiled kernels of
+:mod:`arlequin.models.contact.kernel` when the rows are CSR (always, from the pairs), the numpy
+expressions beside each call being their reference (the same numbers bit for bit).
+
+Size: the shared constraint machinery (geometry per step, records, work) and the two models on
+it stay together (under 600 lines).
 """
 
 from __future__ import annotations
@@ -188,8 +195,15 @@ class _ContactConstraint:
         self._b_cache: tuple[sp.csr_matrix, sp.csr_matrix] | None = None
         self._b_pattern: tuple | None = None  # a G, its rows' −w, its zeros, B's template
         self._geo0 = pair.geometry(self._u0)
-        self._gdofs = getattr(pair, "geometry_dofs", None)
-        self._csr_rows: list = [None, None]  # see _compiled
+        dofs = getattr(pair, "geometry_dofs", None)
+        if dofs is not None:
+            dofs = np.asarray(dofs, dtype=np.int64)
+            if dofs.size and not (0 <= dofs.min() and dofs.max() < pair.n_dofs):
+                raise ValueError(f"contact pair's geometry_dofs must lie in [0, {pair.n_dofs}), "
+                                 f"got [{dofs.min()}, {dofs.max()}]")  # fmt: skip
+        self._gdofs = dofs
+        self._csr_rows: list = [None, None]  # see _compiled: the geometry's rows
+        self._csr_b: list = [None, None]  # and B's
         # a trial's fields that start at zero, shared by every trial (read-only: states and
         # trials are never modified in place; new arrays replace them)
         m = pair.n_points
@@ -258,7 +272,7 @@ class _ContactConstraint:
         # the geometry depends on the pair's dofs alone: compared there (a few hundred values,
         # not the whole system's at every step); == and all() as array_equal for equal shapes
         dofs = self._gdofs
-        if last.shape != u.shape:
+        if last.shape != u.shape or u.shape != (self.pair.n_dofs,):
             same = False
         elif dofs is None or last.dtype != np.float64 or u.dtype != np.float64:
             same = bool((last == u).all() if dofs is None else (last[dofs] == u[dofs]).all())
@@ -340,7 +354,10 @@ class _ContactConstraint:
         # B (v_before + v_after) with the sum on B's columns only (a full-size sum was most of
         # a commit); _make_b's rows are always CSR
         b = trial.matrix
-        b_vsum = rows_times_sum(b.indptr, b.indices, b.data, v_before, v_after)
+        if _compiled(b, v_before, self._csr_b) and v_after.shape == v_before.shape:
+            b_vsum = rows_times_sum(b.indptr, b.indices, b.data, v_before, v_after)
+        else:  # the kernel's reference
+            b_vsum = b @ (v_before + v_after)
         work = state.work - 0.5 * float(np.asarray(impulse) @ b_vsum)
         # the explicit scheme commits at the configuration its step started from: reuse it
         same = trial.u_start is u or np.array_equal(trial.u_start, u)
@@ -443,7 +460,7 @@ class LevelSetContact(_ContactConstraint):
 
     def _first_statuses(self, geo, v, dt, was):
         g = geo.rows
-        if _compiled(g, v, self._csr_rows):
+        if _compiled(g, v, self._csr_rows) and was.shape == geo.gap.shape == (g.shape[0],):
             return level_set_begin(g.indptr, g.indices, g.data, v, geo.gap, dt, was)
         vn0 = g @ v  # the kernel's reference
         gap_pred = geo.gap + dt * vn0
