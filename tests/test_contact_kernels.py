@@ -216,3 +216,11 @@ def test_scaled_entries_equal_numpy(zeros):
         assert same_bytes(out, ref[keep_ref]) and same_bytes(keep, keep_ref)
         assert every == bool(keep_ref.all())
         assert same == (before.shape == keep_ref.shape and np.array_equal(before, keep_ref))
+
+
+def test_geometry_dofs_out_of_range_rejected():
+    surface, n = bar_surface()
+    pair = RigidContactPair(surface, PlaneObstacle([0.0, 0.0], [0.0, 1.0]), n)
+    pair.geometry_dofs = np.array([0, n])  # a pair that names a dof outside the system
+    with pytest.raises(ValueError, match="geometry_dofs"):
+        LevelSetContact(pair, kappa=1.0)
