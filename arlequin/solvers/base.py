@@ -435,10 +435,20 @@ class Integrator:
 
     def _active(self, trials: Sequence[Any]):
         """(G_A, rhs_A, active index lists, row levels is-displacement) of the trials."""
-        g_a, rhs_a, idx = stack_active(trials, self.ops.n, self._stack_cache)
+        cache = self._stack_cache
+        g_a, rhs_a, idx = stack_active(trials, self.ops.n, cache)
+        if not idx:
+            return g_a, rhs_a, idx, np.zeros(0, dtype=bool)
+        # the rows' levels for the same numbers of active rows per constraint kept, read-only
+        key = tuple(a.size for a in idx)
+        levels = cache.get("levels")
+        if levels is not None and levels[0] == key:
+            return g_a, rhs_a, idx, levels[1]
         disp = np.concatenate(
             [np.full(a.size, c.level == "displacement") for c, a in zip(self.unilateral, idx)]
-        ) if idx else np.zeros(0, dtype=bool)  # fmt: skip
+        )
+        disp.flags.writeable = False
+        cache["levels"] = (key, disp)
         return g_a, rhs_a, idx, disp
 
     def _full_multipliers(self, lam_a: np.ndarray, idx: Sequence[np.ndarray]) -> list[np.ndarray]:

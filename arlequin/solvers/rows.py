@@ -67,17 +67,19 @@ def stack_active(trials: Sequence, n: int, cache: dict | None = None):
     idx : list of ndarray of int
         The active row indices of each constraint.
     """
-    rhs, idx = [], []
-    for tr in trials:
-        act = np.nonzero(tr.active)[0]
-        idx.append(act)
-        rhs.append(np.asarray(tr.rhs, dtype=float)[act])
     if not trials:
-        return sp.csr_matrix((0, n)), np.zeros(0), idx
-    # the same matrices with the same active rows (most steps): the same stacked rows
+        return sp.csr_matrix((0, n)), np.zeros(0), []
+    # the same matrices with the same active rows (most steps): the same stacked rows, the
+    # same active indices, and the same right-hand sides when the trials' are the same arrays
+    # (a velocity-level contact's zeros); the cache keeps what it returns read-only
     key = tuple((id(tr.matrix), tr.active.tobytes()) for tr in trials)
     if cache is not None and cache.get("key") == key:
-        return cache["g_a"], np.concatenate(rhs), idx
+        idx = cache["idx"]
+        if all(tr.rhs is r for tr, r in zip(trials, cache["rhs_of"])):
+            return cache["g_a"], cache["rhs_a"], list(idx)
+        return cache["g_a"], _active_rhs(trials, idx), list(idx)
+    idx = [np.nonzero(tr.active)[0] for tr in trials]
+    rhs_a = _active_rhs(trials, idx)
     mats = [tr.matrix if getattr(tr.matrix, "format", None) == "csr" else
             sp.csr_matrix(tr.matrix) for tr in trials]  # fmt: skip
     # new matrices on the same patterns (index arrays, shared while a deforming contact's
@@ -85,35 +87,51 @@ def stack_active(trials: Sequence, n: int, cache: dict | None = None):
     # pattern and the gathers kept, only the entries taken (no scipy constructor a step)
     pattern_key = tuple((id(m.indices), id(m.indptr), a.tobytes())
                         for m, a in zip(mats, (tr.active for tr in trials)))  # fmt: skip
-    pattern = cache.get("pattern") if cache is not None else None
-    if pattern is not None and pattern[0] == pattern_key:
-        g_a = csr_with_data(
-            pattern[1], np.concatenate([m.data[p] for m, p in zip(mats, pattern[2])])
-        )
+    # a few patterns kept, the most recent last: the active rows go back and forth between a
+    # few sets while the statuses settle (a Taylor bar: 44 sets in 80 changes over 755 steps),
+    # and a new set cost 0.18 ms a step in the run, most of it in two scipy constructors
+    patterns = cache.setdefault("patterns", {}) if cache is not None else None
+    entry = patterns.pop(pattern_key, None) if patterns is not None else None
+    if entry is not None:
+        patterns[pattern_key] = entry  # the most recent again
+        g_a = csr_with_data(entry[0], np.concatenate([m.data[p] for m, p in zip(mats, entry[1])]))
     else:
-        g_a, pos = _stack_rows(mats, idx, n)
-        if cache is not None:
-            # the index arrays are kept alive with the key so that their ids cannot be reused;
-            # a template only for read-only index arrays (csr_pattern's: never changed)
-            shared = all(not m.indices.flags.writeable and not m.indptr.flags.writeable
-                         for m in mats)  # fmt: skip
-            cache["pattern"] = None
-            if shared:
-                template = csr_pattern(g_a.indices, g_a.indptr, g_a.shape)
-                cache["pattern"] = (pattern_key, template, pos,
-                                    [(m.indices, m.indptr) for m in mats])  # fmt: skip
-                g_a = csr_with_data(template, g_a.data)
+        data, indices, indptr, pos = _stack_rows(mats, idx, n)
+        shape = (indptr.size - 1, n)
+        # a template only for read-only index arrays (csr_pattern's: never changed), kept with
+        # the index arrays so that their ids cannot be reused
+        shared = all(not m.indices.flags.writeable and not m.indptr.flags.writeable
+                     for m in mats)  # fmt: skip
+        if patterns is not None and shared:
+            template = csr_pattern(indices, indptr, shape)
+            patterns[pattern_key] = (template, pos, [(m.indices, m.indptr) for m in mats])
+            if len(patterns) > _KEPT_PATTERNS:
+                del patterns[next(iter(patterns))]  # the least recently used
+            g_a = csr_with_data(template, data)
+        else:
+            g_a = sp.csr_matrix((data, indices, indptr), shape=shape)
     if cache is not None:
-        # the matrices are kept alive with the key so that their ids cannot be reused
-        cache.update(key=key, g_a=g_a, matrices=[tr.matrix for tr in trials])
-    return g_a, np.concatenate(rhs), idx
+        # the matrices and right-hand sides are kept alive with the key so that their ids
+        # cannot be reused
+        for a in (*idx, rhs_a):
+            a.flags.writeable = False
+        cache.update(key=key, g_a=g_a, matrices=[tr.matrix for tr in trials], idx=idx,
+                     rhs_of=[tr.rhs for tr in trials], rhs_a=rhs_a)  # fmt: skip
+        idx = list(idx)
+    return g_a, rhs_a, idx
+
+
+def _active_rhs(trials: Sequence, idx: Sequence[np.ndarray]) -> np.ndarray:
+    """The right-hand sides of the trials' active rows ``idx``, stacked, shape (m_A,)."""
+    return np.concatenate([np.asarray(tr.rhs, dtype=float)[act] for tr, act in zip(trials, idx)])
 
 
 def _stack_rows(mats: Sequence[sp.csr_matrix], idx: Sequence[np.ndarray], n: int):
-    """``sp.vstack([m[i] for m, i in zip(mats, idx)], format="csr")``, the same arrays, from
-    the CSR arrays in a few vectorised gathers: scipy's row indexing and stacking took twice as
-    long (0.14 against 0.07 ms a step of the ball impact, whose deformable pair's rows change
-    every step). Returns it and the positions of its entries in each matrix's arrays."""
+    """The CSR arrays of ``sp.vstack([m[i] for m, i in zip(mats, idx)], format="csr")``
+    (data, indices, indptr), in a few vectorised gathers: scipy's row indexing and stacking
+    took twice as long (0.14 against 0.07 ms a step of the ball impact, whose deformable
+    pair's rows change every step), and the positions of its entries in each matrix's arrays.
+    """
     data, indices, counts, positions = [], [], [], []
     for mat, act in zip(mats, idx):
         start = mat.indptr[act]
@@ -129,12 +147,11 @@ def _stack_rows(mats: Sequence[sp.csr_matrix], idx: Sequence[np.ndarray], n: int
     indptr = np.zeros(cnt.size + 1, dtype=np.int64)
     np.cumsum(cnt, out=indptr[1:])
     index_dtype = np.int32 if max(n, int(indptr[-1])) < np.iinfo(np.int32).max else np.int64
-    g_a = sp.csr_matrix(
-        (np.concatenate(data), np.concatenate(indices).astype(index_dtype, copy=False),
-         indptr.astype(index_dtype, copy=False)),
-        shape=(cnt.size, n),
-    )  # fmt: skip
-    return g_a, positions
+    return (np.concatenate(data), np.concatenate(indices).astype(index_dtype, copy=False),
+            indptr.astype(index_dtype, copy=False), positions)  # fmt: skip
+
+
+_KEPT_PATTERNS = 16  # stacked-row patterns kept by stack_active's cache
 
 
 def scatter_active(values: np.ndarray, idx: Sequence[np.ndarray], sizes: Sequence[int]):

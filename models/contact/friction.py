@@ -43,7 +43,7 @@ explicit integrator (slip tractions are applied forces; ``explicit_only``).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -51,7 +51,7 @@ import scipy.sparse as sp
 
 from .geometry import ContactGeometry, ContactPair, RigidContactPair
 from .level_set import LevelSetContact
-from .records import ContactState, ContactTrial
+from .records import ContactState, ContactTrial, evolve
 
 __all__ = ["CoulombContact", "FrictionState", "FrictionTrial", "tangents"]
 
@@ -186,13 +186,19 @@ class CoulombContact(LevelSetContact):
         """G_t: v ↦ [[v_t]] at the points, shape ((dim − 1) m, n), row j m + k."""
         cached = self._t_cache
         rigid = isinstance(self.pair, RigidContactPair)
-        if rigid and cached is not None and np.array_equal(cached[0], geo.normal):
+        if (
+            rigid
+            and cached is not None
+            and (cached[0] is geo.normal or np.array_equal(cached[0], geo.normal))
+        ):
             return cached[1]  # a rigid pair's rows depend on its normals only
         if geo.jump is None:
             raise ValueError("the contact pair gives no velocity-jump rows (ContactGeometry.jump)")
         t = tangents(geo.normal) * self._frictional[None, None, :]  # (nt, dim, m)
         g = sp.vstack([geo.jump(t[j]) for j in range(t.shape[0])], format="csr")
-        self._t_cache = (geo.normal.copy(), g)
+        # read-only normals (a plane's, the same array every step) are kept as they are
+        n = geo.normal
+        self._t_cache = (n if not n.flags.writeable else n.copy(), g)
         return g
 
     def _stack(self, ntrial: ContactTrial, g_t: sp.csr_matrix) -> sp.csr_matrix:
@@ -254,7 +260,7 @@ class CoulombContact(LevelSetContact):
         changed = (ntrial.changed or bool(np.any(stick != trial.stick))
                    or moved > self.slip_tolerance * max(scale, 1e-300))  # fmt: skip
         applied = np.concatenate([np.zeros(m), applied_t.ravel()])
-        return replace(
+        return evolve(
             trial, active=np.concatenate([ntrial.active, np.tile(stick, nt)]), changed=changed,
             iterations=trial.iterations + 1, applied=applied, normal=ntrial, stick=stick,
             vt=vt,

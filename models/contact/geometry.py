@@ -133,6 +133,7 @@ class ContactSurface:
             contrib = (2.0 * np.pi * meas[:, None] * (2.0 * r + r[:, ::-1]) / 6.0).ravel()
         self.weights = np.bincount(inv, contrib, minlength=nodes.size)
         self._dofs = self.node_dofs(nodes)  # (dim, m): the pairs' geometry needs them each step
+        self._x_ref = mesh.p[:, nodes]  # (dim, m), likewise
 
     @property
     def n_points(self) -> int:
@@ -145,7 +146,7 @@ class ContactSurface:
     def positions(self, u: np.ndarray, nodes: np.ndarray | None = None) -> np.ndarray:
         """Current positions X + u of mesh nodes (default: surface nodes), shape (dim, k) (m)."""
         if nodes is None:
-            return self.mesh.p[:, self.nodes] + u[self._dofs]
+            return self._x_ref + u[self._dofs]
         nodes = np.asarray(nodes, dtype=np.int64)
         return self.mesh.p[:, nodes] + u[self.node_dofs(nodes)]
 
@@ -242,23 +243,39 @@ class RigidContactPair(ContactPair):
         self._template = csr_pattern(self._c.astype(index_dtype),
                                      np.arange(0, m * d + 1, d, dtype=index_dtype),
                                      (m, self.n_dofs))  # fmt: skip
+        # the velocity-jump rows depend on the reference configuration alone
+        self._jump = _JumpRows((self._r, self._c), (m, self.n_dofs))
+        # an obstacle whose normal is the same everywhere (a plane): the normals and the rows
+        # made once here, the same objects at every step (the integrators' caches keyed on
+        # them hold), only φ computed per step (the normals took half of a step's geometry)
+        self._fixed: tuple[np.ndarray, sp.csr_matrix] | None = None
+        if getattr(obstacle, "constant_normal", False):
+            n = self._normals(slave.positions(np.zeros(self.n_dofs)))
+            n.flags.writeable = False
+            self._fixed = (n, csr_with_data(self._template, (-n).T.ravel()))
 
-    def geometry(self, u: np.ndarray) -> ContactGeometry:
-        x = self.slave.positions(u)
-        phi = self.obstacle.phi(x)
+    def _normals(self, x: np.ndarray) -> np.ndarray:
+        """Unit normals ∇φ/|∇φ| at the points x (dim, m)."""
         g = self.obstacle.gradient(x)
         gn = np.linalg.norm(g, axis=0)
         if np.any(~(gn > 0.0)):
             raise ValueError("obstacle gradient vanishes at a contact point")
-        n = g / gn
+        return g / gn
+
+    def geometry(self, u: np.ndarray) -> ContactGeometry:
+        x = self.slave.positions(u)
+        phi = self.obstacle.phi(x)
+        if self._fixed is not None:
+            n, rows = self._fixed
+            return ContactGeometry(rows, -phi, n, self._jump)
+        n = self._normals(x)
         cached = self._rows_cache
         if cached is not None and np.array_equal(cached[0], n):
-            rows = cached[1]  # same normals (a plane, a resting contact): same rows
+            rows = cached[1]  # same normals (a resting contact): same rows
         else:
             rows = csr_with_data(self._template, (-n).T.ravel())
             self._rows_cache = (n.copy(), rows)
-        jump = _JumpRows((self._r, self._c), (self.slave.n_points, self.n_dofs))
-        return ContactGeometry(rows, -phi, n, jump)
+        return ContactGeometry(rows, -phi, n, self._jump)
 
 
 class DeformableContactPair(ContactPair):

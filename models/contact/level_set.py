@@ -65,18 +65,24 @@ configuration).
 
 :class:`SignoriniContact` is the displacement-level baseline (Newmark + Signorini with a
 Lagrange multiplier, primal–dual active set on ``d_n(u_{n+1}) ≤ 0``).
+
+The per-step arithmetic (the rows' products, the statuses) runs in the compiled kernels of
+:mod:`arlequin.models.contact.kernel` when the rows are CSR (always, from the pairs), the numpy
+expressions beside each call being their reference (the same numbers bit for bit).
+
+Size: the shared constraint machinery (geometry per step, records, work) and the two models on
+it stay together (under 600 lines).
 """
 
 from __future__ import annotations
 
 import logging
-from dataclasses import replace
 from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
 
-from arlequin.contract import SimulationError, same_pattern
+from arlequin.contract import SimulationError, csr_pattern, same_pattern
 
 from .geometry import (
     ContactGeometry,
@@ -84,11 +90,17 @@ from .geometry import (
     ContactSurface,
     DeformableContactPair,
     RigidContactPair,
-    csr_pattern,
     csr_with_data,
 )
+from .kernel import (
+    equal_at,
+    level_set_begin,
+    level_set_status,
+    rows_times_sum,
+    scaled_entries,
+)
 from .obstacles import LevelSetObstacle, Obstacle, PlaneObstacle, SphereObstacle
-from .records import ContactHistory, ContactRecord, ContactState, ContactTrial
+from .records import ContactHistory, ContactRecord, ContactState, ContactTrial, build, evolve
 
 __all__ = [
     "ContactConvergenceError",
@@ -139,6 +151,17 @@ def acoustic_impedance(young: float, density: float, poisson: float | None = Non
     return float(np.sqrt(modulus * density))
 
 
+def _compiled(g: Any, x: np.ndarray, last: list) -> bool:
+    """Whether the compiled kernels apply to rows g and a vector x: CSR rows of floats and a
+    float vector of their width (else the numpy reference, the same numbers). ``last`` keeps
+    the last rows found CSR of floats and their width (a plane's rows: the same every step)."""
+    if last[0] is not g:
+        if not (getattr(g, "format", None) == "csr" and g.data.dtype == np.float64):
+            return False
+        last[0], last[1] = g, (g.shape[1],)
+    return x.dtype == np.float64 and x.shape == last[1]
+
+
 class _ContactConstraint:
     """Shared machinery: the geometry per step, the records, the contact work."""
 
@@ -172,6 +195,21 @@ class _ContactConstraint:
         self._b_cache: tuple[sp.csr_matrix, sp.csr_matrix] | None = None
         self._b_pattern: tuple | None = None  # a G, its rows' −w, its zeros, B's template
         self._geo0 = pair.geometry(self._u0)
+        dofs = getattr(pair, "geometry_dofs", None)
+        if dofs is not None:
+            dofs = np.asarray(dofs, dtype=np.int64)
+            if dofs.size and not (0 <= dofs.min() and dofs.max() < pair.n_dofs):
+                raise ValueError(f"contact pair's geometry_dofs must lie in [0, {pair.n_dofs}), "
+                                 f"got [{dofs.min()}, {dofs.max()}]")  # fmt: skip
+        self._gdofs = dofs
+        self._csr_rows: list = [None, None]  # see _compiled: the geometry's rows
+        self._csr_b: list = [None, None]  # and B's
+        # a trial's fields that start at zero, shared by every trial (read-only: states and
+        # trials are never modified in place; new arrays replace them)
+        m = pair.n_points
+        self._zeros = (np.zeros(m), np.zeros(m, dtype=bool))
+        for a in self._zeros:
+            a.flags.writeable = False
 
     # rows
     @property
@@ -192,10 +230,17 @@ class _ContactConstraint:
         pat = self._b_pattern
         same = pat is not None and same_pattern(pat[0], gc)
         w = pat[1] if same else np.repeat(-self.pair.weights, np.diff(gc.indptr))
-        data = gc.data * w
-        keep = data != 0.0
-        every = bool(keep.all())
-        if not (same and np.array_equal(pat[2], keep)):
+        if gc.data.dtype == np.float64 and same:
+            # one call: the entries scaled, the kept ones, whether the zeros are where they
+            # were (the same numbers as the numpy lines below, their reference)
+            kept_data, keep, same, every = scaled_entries(gc.data, w, pat[2])
+        else:
+            data = gc.data * w
+            keep = data != 0.0
+            every = bool(keep.all())
+            same = same and np.array_equal(pat[2], keep)
+            kept_data = data if every else data[keep]
+        if not same:
             if every:
                 indices, indptr = gc.indices, gc.indptr
             else:
@@ -203,7 +248,7 @@ class _ContactConstraint:
                 indices, indptr = gc.indices[keep], kept[gc.indptr]
             pat = (gc, w, keep, csr_pattern(indices.copy(), indptr.copy(), gc.shape))
             self._b_pattern = pat
-        b = csr_with_data(pat[3], data if every else data[keep])
+        b = csr_with_data(pat[3], kept_data)
         self._b_cache = (g, b)
         return b
 
@@ -225,11 +270,17 @@ class _ContactConstraint:
         if last is u:
             return state.geometry
         # the geometry depends on the pair's dofs alone: compared there (a few hundred values,
-        # not the whole system's at every step)
-        dofs = getattr(self.pair, "geometry_dofs", None)
-        same = np.array_equal(last, u) if dofs is None or last.shape != u.shape else \
-            np.array_equal(last[dofs], u[dofs])  # fmt: skip
-        return state.geometry if same else self.geometry(u)
+        # not the whole system's at every step); == and all() as array_equal for equal shapes
+        dofs = self._gdofs
+        if last.shape != u.shape or u.shape != (self.pair.n_dofs,):
+            same = False
+        elif dofs is None or last.dtype != np.float64 or u.dtype != np.float64:
+            same = bool((last == u).all() if dofs is None else (last[dofs] == u[dofs]).all())
+        else:
+            same = equal_at(last, u, dofs)
+        if same:
+            return state.geometry
+        return self.pair.geometry(u) if self.update_geometry else self.geometry(u)
 
     def gaps(self, u: np.ndarray) -> np.ndarray:
         """d_n (m) at the collocation points for displacement u, shape (m,)."""
@@ -247,21 +298,25 @@ class _ContactConstraint:
             np.zeros(m),
         )
 
-    def _trial(self, state, t, dt, u, v, statuses) -> ContactTrial:
-        """The step's trial; ``statuses(vn0, gap_pred)`` gives its first active statuses and
-        its S_d, both (m,) bool, from the start-of-step [[v_n]] and the predicted gap (one
-        trial object a step, not a copy for S_d)."""
+    def _first_statuses(self, geo: ContactGeometry, v: np.ndarray, dt: float,
+                        was: np.ndarray) -> tuple[np.ndarray, ...]:  # fmt: skip
+        """``(vn0, gap_pred, s_d, active)`` of a step: [[v_n]] (m/s) at its start, the
+        predicted gap (m), S_d and the first active statuses (bool), each (m,), from the
+        geometry at its start, its free velocity v, its size dt (s) and the last statuses."""
+        raise NotImplementedError
+
+    def _trial(self, state, t, dt, u, v) -> ContactTrial:
+        """The step's trial, its first statuses by :meth:`_first_statuses` (one trial object a
+        step, not a copy for S_d)."""
         geo = self._geometry_from(state, u)
-        vn0 = geo.rows @ v
-        m = self.pair.n_points
-        gap_pred = geo.gap + dt * vn0
-        active, s_d = statuses(vn0, gap_pred)
-        return ContactTrial(
-            active=active, matrix=self._make_b(geo.rows), rhs=np.zeros(m),
+        vn0, gap_pred, s_d, active = self._first_statuses(geo, v, float(dt), state.active)
+        zero, false = self._zeros
+        # the geometry's gap is never modified: no copy of it for gap_start
+        return build(
+            ContactTrial, active=active, matrix=self._make_b(geo.rows), rhs=zero,
             changed=False, iterations=0, t=float(t), dt=float(dt), geometry=geo,
-            gap_start=geo.gap.copy(), vn_start=vn0, gap_pred=gap_pred,
-            s_d=s_d, s_v=np.zeros(m, dtype=bool),
-            used=np.zeros(m, dtype=bool), lam=np.zeros(m), vn=vn0, u_start=u,
+            gap_start=geo.gap, vn_start=vn0, gap_pred=gap_pred,
+            s_d=s_d, s_v=false, used=false, lam=zero, vn=vn0, u_start=u,
         )  # fmt: skip
 
     def commit(
@@ -296,13 +351,19 @@ class _ContactConstraint:
             if self.on_failure == "raise":
                 raise ContactConvergenceError(msg, 0, t)
             logger.warning(msg)
-        vsum = v_before + v_after
-        work = state.work - 0.5 * float(np.asarray(impulse) @ (trial.matrix @ vsum))
+        # B (v_before + v_after) with the sum on B's columns only (a full-size sum was most of
+        # a commit); _make_b's rows are always CSR
+        b = trial.matrix
+        if _compiled(b, v_before, self._csr_b) and v_after.shape == v_before.shape:
+            b_vsum = rows_times_sum(b.indptr, b.indices, b.data, v_before, v_after)
+        else:  # the kernel's reference
+            b_vsum = b @ (v_before + v_after)
+        work = state.work - 0.5 * float(np.asarray(impulse) @ b_vsum)
         # the explicit scheme commits at the configuration its step started from: reuse it
         same = trial.u_start is u or np.array_equal(trial.u_start, u)
         geo_end = trial.geometry if same else self.geometry(u)
-        record = ContactRecord(
-            t=float(t), iterations=trial.iterations, converged=not trial.changed,
+        record = build(
+            ContactRecord, t=float(t), iterations=trial.iterations, converged=not trial.changed,
             active=trial.used, s_d=trial.s_d, s_v=trial.s_v, gap=geo_end.gap,
             gap_start=trial.gap_start, vn_start=trial.vn_start, vn=trial.vn, lam=trial.lam,
             work=work, dt=trial.dt,
@@ -310,15 +371,11 @@ class _ContactConstraint:
         total = np.asarray(impulse, dtype=float)
         if state.impulse is not None:
             total = state.impulse + total
-        return ContactState(
-            trial.used.copy(),
-            work,
-            record,
-            trial.lam.copy(),
-            geo_end,
-            np.array(u, copy=True),
-            total,
-        )
+        # the trial's arrays are the constraint's own (update_status copied the multipliers),
+        # never modified: kept without copies; u is the integrator's, copied
+        return build(ContactState, active=trial.used, work=work, record=record,
+                     multipliers=trial.lam, geometry=geo_end, u_geometry=u.copy(),
+                     impulse=total)  # fmt: skip
 
     def history(self, result: Any) -> ContactHistory:
         """The records of this constraint in a :class:`~arlequin.solvers.DynamicResult`,
@@ -399,27 +456,36 @@ class LevelSetContact(_ContactConstraint):
         """Rows at u; S_d on the predicted end-of-step gap d_n + Δt [[v_n]] (v: the step's free
         velocity), kept at 1 for points active in the last step (their gap is frozen); first
         guess: persistent contacts and newly closed approaching points."""
-        was = state.active
+        return self._trial(state, t, dt, u, v)
 
-        def guess(vn0, gap_pred):
-            s_d = (gap_pred >= 0.0) | was
-            return s_d & (was | (vn0 > 0.0)), s_d
-
-        return self._trial(state, t, dt, u, v, guess)
+    def _first_statuses(self, geo, v, dt, was):
+        g = geo.rows
+        if _compiled(g, v, self._csr_rows) and was.shape == geo.gap.shape == (g.shape[0],):
+            return level_set_begin(g.indptr, g.indices, g.data, v, geo.gap, dt, was)
+        vn0 = g @ v  # the kernel's reference
+        gap_pred = geo.gap + dt * vn0
+        s_d = (gap_pred >= 0.0) | was
+        return vn0, gap_pred, s_d, s_d & (was | (vn0 > 0.0))
 
     def update_status(
         self, trial: ContactTrial, u: np.ndarray, v: np.ndarray, multipliers: np.ndarray
     ) -> ContactTrial:
         """New active statuses from the trial fields (the indicator fields S_d, S_v at the
         collocation points); whether any changed."""
-        lam = np.asarray(multipliers, dtype=float)
-        vn = trial.geometry.rows @ v  # [[v_n]] with the step's rows
-        used = trial.active
-        s_v = lam - self.kappa * vn <= 0.0
-        new = trial.s_d & s_v
-        return replace(
-            trial, active=new, changed=bool(np.any(new != used)),
-            iterations=trial.iterations + 1, used=used.copy(), lam=lam.copy(), vn=vn, s_v=s_v,
+        lam = np.array(multipliers, dtype=float)  # a copy: the integrator's array
+        g = trial.geometry.rows  # [[v_n]] with the step's rows
+        used = trial.active  # made by this constraint, never modified: kept as it is
+        if _compiled(g, v, self._csr_rows) and lam.shape == used.shape:
+            vn, s_v, new, changed = level_set_status(g.indptr, g.indices, g.data, v, lam,
+                                                     self.kappa, trial.s_d, used)  # fmt: skip
+        else:  # the kernel's reference
+            vn = g @ v
+            s_v = lam - self.kappa * vn <= 0.0
+            new = trial.s_d & s_v
+            changed = bool((new != used).any())
+        return evolve(
+            trial, active=new, changed=changed,
+            iterations=trial.iterations + 1, used=used, lam=lam, vn=vn, s_v=s_v,
         )  # fmt: skip
 
     def weak_residual(
@@ -484,13 +550,14 @@ class SignoriniContact(_ContactConstraint):
     ) -> ContactTrial:
         """Rows at u, right-hand side ``B u^{n+1} = −W (G u^n − d_n(u^n))`` (the linearised
         ``d_n(u^{n+1}) = 0``); the statuses start from the last step's."""
-
-        def first(vn0, gap_pred):  # the last step's statuses; S_d is not used here
-            return state.active.copy(), np.zeros(self.pair.n_points, dtype=bool)
-
-        trial = self._trial(state, t, dt, u, v, first)
+        trial = self._trial(state, t, dt, u, v)
         rhs = -self.pair.weights * (trial.geometry.rows @ u - trial.geometry.gap)
-        return replace(trial, rhs=rhs)
+        return evolve(trial, rhs=rhs)
+
+    def _first_statuses(self, geo, v, dt, was):
+        # the last step's statuses; S_d is not used here
+        vn0 = geo.rows @ v
+        return vn0, geo.gap + dt * vn0, np.zeros(self.pair.n_points, dtype=bool), was.copy()
 
     def update_status(
         self, trial: ContactTrial, u: np.ndarray, v: np.ndarray, multipliers: np.ndarray
@@ -502,8 +569,8 @@ class SignoriniContact(_ContactConstraint):
         gap = trial.gap_start + g @ (u - trial.u_start)
         used = trial.active
         new = np.where(used, lam <= 0.0, gap > self.gap_tol)
-        return replace(
+        return evolve(
             trial, active=new, changed=bool(np.any(new != used)),
-            iterations=trial.iterations + 1, used=used.copy(), lam=lam.copy(), vn=g @ v,
+            iterations=trial.iterations + 1, used=used, lam=lam.copy(), vn=g @ v,
             s_d=gap > self.gap_tol, s_v=lam <= 0.0,
         )  # fmt: skip

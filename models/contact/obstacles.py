@@ -19,7 +19,16 @@ class Obstacle:
     """A rigid obstacle given by a level-set function φ (m), φ > 0 in free space.
 
     Subclasses implement :meth:`phi` and :meth:`gradient`; points are arrays of shape (dim, m).
+
+    Attributes
+    ----------
+    constant_normal : bool
+        The gradient is the same at every point (a plane): a contact pair then computes the
+        normals and the velocity-jump rows once, not at every step. False unless a subclass
+        knows it.
     """
+
+    constant_normal: bool = False
 
     def phi(self, x: np.ndarray) -> np.ndarray:
         """φ(x) (m), shape (m,)."""
@@ -40,6 +49,8 @@ class PlaneObstacle(Obstacle):
     normal : array_like, shape (dim,)
         Normal pointing into free space (normalised here).
     """
+
+    constant_normal = True
 
     def __init__(self, point, normal) -> None:
         self.point = np.asarray(point, dtype=float).ravel()

@@ -5,13 +5,53 @@ the per-step records stacked into a history (all immutable, SI units; see
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
 
 from .geometry import ContactGeometry
 
-__all__ = ["ContactHistory", "ContactRecord", "ContactState", "ContactTrial"]
+__all__ = ["ContactHistory", "ContactRecord", "ContactState", "ContactTrial", "build", "evolve"]
+
+
+def build(cls: type, **fields: Any) -> Any:
+    """``cls(**fields)`` for the frozen records of this module, every field given: their
+    generated ``__init__`` sets each field through ``object.__setattr__`` (2.1 µs for a
+    trial's 17 fields, against 1.2 µs here; several records a step).
+
+    Raises
+    ------
+    TypeError
+        If ``fields`` are not exactly the fields of ``cls``.
+    """
+    if fields.keys() != cls.__dataclass_fields__.keys():
+        raise TypeError(f"{cls.__name__} needs the fields {list(cls.__dataclass_fields__)}, "
+                        f"got {list(fields)}")  # fmt: skip
+    new = object.__new__(cls)
+    new.__dict__.update(fields)
+    return new
+
+
+def evolve(record: Any, **changes: Any) -> Any:
+    """``dataclasses.replace(record, **changes)`` for frozen dataclass records (this module's,
+    the friction trial: no ``__post_init__``, no ``InitVar``, every field in ``__init__``),
+    without its per-call field introspection
+    and keyword ``__init__``: 1 µs against 4 µs, at every status iteration of every step.
+
+    Raises
+    ------
+    TypeError
+        If a name in ``changes`` is not a field of the record.
+    """
+    fields = type(record).__dataclass_fields__
+    for name in changes:
+        if name not in fields:
+            raise TypeError(f"{type(record).__name__} has no field {name!r}")
+    new = object.__new__(type(record))
+    new.__dict__.update(record.__dict__)
+    new.__dict__.update(changes)
+    return new
 
 
 @dataclass
