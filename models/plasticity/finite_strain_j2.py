@@ -3,15 +3,11 @@
 Its consistent tangent: :mod:`arlequin.models.plasticity.j2_tangent` (numpy) and
 :mod:`arlequin.models.plasticity.j2_tangent_kernel` (numba).
 
-The model ties three pieces together: the Q1 kinematics with F-bar
-(:mod:`arlequin.models.plasticity.kinematics`), the J2 material point
-(:mod:`arlequin.models.plasticity.j2`: Hencky elasticity, exponential-map return, any hardening law
-of
-:mod:`arlequin.models.plasticity.hardening`) and, for the built-in hardening laws, the compiled
-kernels that fuse them (``backend="numba"``, the default there):
-:mod:`arlequin.models.plasticity.j2_kernel` for planar cells (axisymmetric, plane strain),
-:mod:`arlequin.models.plasticity.j2_kernel_3d` for hexahedra. The numpy path (``backend="numpy"``)
-is the reference the kernels are tested against.
+The model ties together the Q1 kinematics with F-bar (:mod:`~.kinematics`), the J2 material
+point (:mod:`~.j2`: Hencky elasticity, exponential-map return, any law of :mod:`~.hardening`)
+and, for the built-in laws, the compiled kernels that fuse them (``backend="numba"``, the
+default there: :mod:`~.j2_kernel` for planar cells, :mod:`~.j2_kernel_3d` for hexahedra). The
+numpy path (``backend="numpy"``) is the reference the kernels are tested against.
 
 Optional artificial bulk viscosity (off by default): on compression a pressure
 q = ρ (c_quad ℓ² ε̇_v² − c_lin ℓ c_d ε̇_v) (ε̇_v = J̄̇/J̄ from the step, ρ = ρ₀/J̄, ℓ the cell size)
@@ -540,16 +536,9 @@ class FiniteStrainJ2(CellStates):
         return float(np.sum(alpha * self.kin.dv0 * psi))
 
     def stored_energy_of_state(self, state: PlasticState, weight: WeightLike = None) -> float:
-        """Elastic stored energy Σ w₀ ψ (J) of a state (:meth:`elastic_energy_of_state`), the
-        member of the energy contract that pairs it with :meth:`plastic_dissipation`.
-
-        Raises
-        ------
-        ValueError
-            With bulk viscosity: its work is dissipated too (:meth:`viscous_dissipation`), so
-            the pair would not close an energy balance; callers that account for it take
-            :meth:`elastic_energy_of_state`.
-        """
+        """:meth:`elastic_energy_of_state` (J) as the energy contract's member paired with
+        :meth:`plastic_dissipation`: a ``ValueError`` with bulk viscosity, whose work is
+        dissipated too (the pair would not close a balance)."""
         if self.bulk_viscosity:
             raise ValueError("stored_energy_of_state: with bulk viscosity the dissipation is not "
                              "plastic_dissipation alone (the viscous work too); the elastic "
@@ -560,11 +549,8 @@ class FiniteStrainJ2(CellStates):
         """Elastic energy Σ w₀ ψ (J) from a state's own Kirchhoff stress: for the Hencky law
         τ = K ln J 1 + 2G dev ε_e, so ψ = (tr τ)²/(18 K) + ‖dev τ‖²/(4 G).
 
-        The same as :meth:`stored_energy` at the displacement the state was evaluated at (to
-        round-off), without recomputing the kinematics: a product per quadrature point. The
-        state's τ is the material stress (the bulk viscosity's pressure is not stored in it),
-        so this holds with bulk viscosity too.
-        """
+        :meth:`stored_energy` at the state's own displacement (to round-off) without the
+        kinematics; valid with bulk viscosity (the state's τ is the material stress)."""
         alpha = self.elastic.weight_at_quadrature(weight)
         tau = state.kirchhoff
         tr = tau[0, 0] + tau[1, 1] + tau[2, 2]
@@ -586,26 +572,26 @@ class FiniteStrainJ2(CellStates):
     def critical_time_step(self, u: np.ndarray, state: PlasticState | None = None) -> float:
         """Estimate (s) of the explicit critical step in the configuration X + u.
 
-        min over the cells of κ_c h_c(u)/c_d, with h_c the cell's measure over its longest edge
-        (its thickness) and κ_c calibrated once per cell so that at u = 0 the estimate is the
-        element eigenvalue bound of :func:`~arlequin.models.elastic.element_critical_step` (a
-        lower bound of the critical step). Cheap enough to follow, every few steps, the cells
-        crushed during a run. Capability ``"critical_time_step"``.
-        """
+        min over the cells of κ_c h_c(u)/c_d, h_c the cell's measure over its longest edge, κ_c
+        calibrated once per cell so that at u = 0 it is the element eigenvalue bound of
+        :func:`~arlequin.models.elastic.element_critical_step` (a lower bound of the critical
+        step): cheap enough to follow crushed cells. Capability ``"critical_time_step"``."""
         cd = self.material.dilatational_wave_speed
         if self._critical_ratio is None:
             per_cell = element_critical_step(self.elastic, self.elastic.basis, per_cell=True)
             self._critical_ratio = per_cell * cd / self.kin.cell_sizes(self.mesh.p)
-        if self.backend == "numba" and self.dim == 2:
+        if self.backend == "numba" and self.dim == 2:  # the same floats, compiled
             from .j2_kernel import min_scaled_cell_size
 
             if self._size_arrays is None:  # one type for the compiled loop whatever the mesh's
-                c = np.ascontiguousarray
-                self._size_arrays = (c(self.mesh.p, dtype=float), c(self.mesh.t, dtype=np.int64),
-                                     c(self.kin.dofs, dtype=np.int64))  # fmt: skip
-            u = self._checked_displacement(u)
-            h_min = min_scaled_cell_size(*self._size_arrays, u, self._critical_ratio)
-            return float(h_min / cd)
+                c, i8 = np.ascontiguousarray, np.int64
+                self._size_arrays = (
+                    c(self.mesh.p, float),
+                    c(self.mesh.t, i8),
+                    c(self.kin.dofs, i8),
+                )
+            args = (*self._size_arrays, self._checked_displacement(u), self._critical_ratio)
+            return float(min_scaled_cell_size(*args) / cd)
         h = self.kin.cell_sizes(self.current_coordinates(u))
         return float(np.min(self._critical_ratio * h) / cd)
 
