@@ -266,9 +266,6 @@ class CentralDifference(Integrator):
         converged = False
         it = 0
         v_free, r_e0 = v_star, r_e
-        # the equality rows' velocity correction M⁻¹Bᵀλ_E of the last iteration, kept while
-        # λ_E is the same array (the solver returns its kept solve for an unchanged r_E)
-        corr_e: tuple[np.ndarray, np.ndarray] | None = None
         while it < self.max_status_iterations:
             it += 1
             g_a, rhs_a, idx, disp = self._active(trials)
@@ -286,9 +283,7 @@ class CentralDifference(Integrator):
             lam_e, lam_a = solver.solve(r_e, g_a, r_a)
             v_new = v_star.copy()
             if rows.m:
-                if corr_e is None or corr_e[0] is not lam_e:
-                    corr_e = (lam_e, self._minv_cols * (rows.matrix_cols_t @ lam_e))
-                v_new[rows.cols] -= corr_e[1]
+                v_new[rows.cols] -= self._minv_cols * (rows.matrix_cols_t @ lam_e)
             if g_a.shape[0]:
                 push = transposed_times(g_a, lam_a)
                 push *= minv  # M⁻¹ Gᵀλ in Gᵀλ's own new array (commutative: the same bits)

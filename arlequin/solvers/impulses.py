@@ -39,7 +39,6 @@ class ImpulseSolver:
         else:
             self.lu = None
         self._s_ee: sp.csc_matrix | None = None
-        self._last_equality: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         # Bᵀ of the equality rows, once (the Schur complement's S_AE = G_A M⁻¹ Bᵀ every step)
         self._eq_t = rows.matrix.T.tocsr() if self.m_e else None
         # the last active rows' arrays, their factor and the rows object they came from
@@ -68,21 +67,8 @@ class ImpulseSolver:
         return self._s_ee
 
     def solve_equality(self, r: np.ndarray) -> np.ndarray:
-        """Λ_E (N·s per row unit) of the equality rows alone for the right-hand side r (m_E,).
-
-        A read-only array, kept with a copy of r: the same right-hand side again (the contact's
-        status iterations of an explicit step, where the active rows share no dof with the
-        equality rows) returns it without a new solve (18 µs on the Taylor bar's band).
-        """
-        if not self.m_e:
-            return np.zeros(0)
-        last = self._last_equality
-        if last is not None and last[0] is r and np.array_equal(last[1], r):
-            return last[2]
-        lam = self.lu.solve(r)
-        lam.flags.writeable = False
-        self._last_equality = (r, r.copy(), lam)
-        return lam
+        """Λ_E (N·s per row unit) of the equality rows alone for the right-hand side r (m_E,)."""
+        return self.lu.solve(r) if self.m_e else np.zeros(0)
 
     def _cached(self, key: tuple, build, owner: Any = None):
         """The factorisation for the active rows ``key`` (their CSR arrays): the last one if
