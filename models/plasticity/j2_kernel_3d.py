@@ -21,7 +21,7 @@ import math
 import numba as nb
 import numpy as np
 
-from .j2_kernel import SQRT23, _flow, _plastic_multiplier, assemble_cell_forces
+from .j2_kernel import SQRT23, _flow, _plastic_multiplier, assemble_cell_forces, thread_slots
 
 __all__ = ["solid_j2_kernel", "solid_scratch", "warm_up_solid"]
 
@@ -315,9 +315,9 @@ def solid_j2_kernel(
 
 
 def solid_scratch(n_qp: int = 8, nen: int = 8) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Per-thread scratch buffers of :func:`solid_j2_kernel`."""
-    n = nb.config.NUMBA_NUM_THREADS
-    return np.empty((n, n_qp, 19)), np.empty((n, n_qp + 1, nen, 3)), np.empty((n, 4, 3, 3))
+    """Per-thread scratch buffers of :func:`solid_j2_kernel` (each thread's on its own cache
+    lines, :func:`~arlequin.models.plasticity.j2_kernel.thread_slots`)."""
+    return thread_slots((n_qp, 19)), thread_slots((n_qp + 1, nen, 3)), thread_slots((4, 3, 3))
 
 
 def warm_up_solid() -> None:

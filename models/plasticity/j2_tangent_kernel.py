@@ -22,9 +22,8 @@ from __future__ import annotations
 import math
 
 import numba as nb
-import numpy as np
 
-from .j2_kernel import SQRT23, _flow, _plastic_multiplier, _rate_slope, _slope
+from .j2_kernel import SQRT23, _flow, _plastic_multiplier, _rate_slope, _slope, thread_slots
 from .j2_kernel_3d import _jacobi3
 
 __all__ = ["j2_tangent_kernel", "tangent_scratch"]
@@ -282,10 +281,10 @@ def _point_blocks(g, C, tau, CG, w0, jw, p, K, fbar, nen, dim, ke, acc):
 
 
 def tangent_scratch(n_qp: int, nen: int, dim: int):
-    """Per-thread scratch of :func:`j2_tangent_kernel`."""
-    t = nb.config.NUMBA_NUM_THREADS
+    """Per-thread scratch of :func:`j2_tangent_kernel` (each thread's on its own cache lines,
+    :func:`~arlequin.models.plasticity.j2_kernel.thread_slots`)."""
     n = nen * dim
     return (
-        np.empty((t, n_qp, 19)), np.empty((t, n_qp, nen, 4)), np.empty((t, 4, 3, 3)),
-        np.empty((t, 3, 3, 3, 3)), np.empty((t, 3, 3, nen, dim)), np.empty((t, n + 1, n)),
+        thread_slots((n_qp, 19)), thread_slots((n_qp, nen, 4)), thread_slots((4, 3, 3)),
+        thread_slots((3, 3, 3, 3)), thread_slots((3, 3, nen, dim)), thread_slots((n + 1, n)),
     )  # fmt: skip
