@@ -32,6 +32,7 @@ from ..contract import (
     is_linear,
 )
 from ..problem.system import Block, BlockTerm, CoupledSystem
+from .csr import CsrProduct
 from .timing import SWITCH
 
 __all__ = ["TANGENTS", "SystemOperators", "as_system", "as_vector"]
@@ -224,7 +225,7 @@ class SystemOperators:
                 f[idx] = k_rows @ u
         else:
             # the assembled (linear) part; nothing to multiply when every term is nonlinear
-            f = self.stiffness @ u if self.stiffness.nnz else np.zeros(u.shape)
+            f = self._stiffness_times(u) if self.stiffness.nnz else np.zeros(u.shape)
             terms = self._nonlinear_terms
         if timer is not None:
             timer.linear_algebra += timer.clock() - tic
@@ -286,6 +287,17 @@ class SystemOperators:
             terms = [(bi, ti, t) for bi, ti, t in self._nonlinear_terms if bi in blocks]
             cache[blocks] = (idx, self.stiffness[idx].tocsr(), terms)
         return cache[blocks]
+
+    def _stiffness_times(self, u: np.ndarray) -> np.ndarray:
+        """K u (N) with the linear stiffness, compiled (:class:`~arlequin.solvers.csr.CsrProduct`,
+        the floats of ``K @ u``), built on first use and again if the matrix is replaced."""
+        product = self.__dict__.get("_stiffness_product")
+        if product is None or product[0] is not self.stiffness:
+            product = self.__dict__["_stiffness_product"] = (
+                self.stiffness,
+                CsrProduct(self.stiffness),
+            )
+        return product[1](u)
 
     def initial_stiffness(self) -> sp.csr_matrix:
         """Block-diagonal weighted stiffness of every block (N/m): the linear stiffness, and the

@@ -1,0 +1,59 @@
+"""The compiled CSR product (arlequin/solvers/csr.py) against scipy's ``A @ x``.
+
+The explicit loop's linear forces go through it, and the issue-30 rule is that the histories do
+not change: so the products must be scipy's floats bit for bit (the same additions in the same
+order), not merely close, on the serial and on the threaded path.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+import skfem
+from skfem.models.elasticity import lame_parameters, linear_elasticity
+
+from arlequin.solvers import csr
+from arlequin.solvers.csr import CsrProduct
+
+
+def random_csr(seed: int) -> sp.csr_matrix:
+    """Random CSR with empty rows, unsorted column indices and duplicate entries."""
+    rng = np.random.default_rng(seed)
+    n_rows, n_cols, nnz = 300, 250, 4000
+    rows = np.sort(rng.integers(0, n_rows, nnz))
+    rows[rows % 7 == 3] = 0  # some empty rows
+    cols = rng.integers(0, n_cols, nnz)
+    values = rng.standard_normal(nnz) * 10.0 ** rng.integers(-6, 6, nnz)
+    indptr = np.searchsorted(rows, np.arange(n_rows + 1))
+    a = sp.csr_matrix((values, cols, indptr), shape=(n_rows, n_cols))
+    assert not a.has_sorted_indices  # stored order kept: duplicates and unsorted columns
+    return a
+
+
+@pytest.mark.parametrize("threaded", [False, True])
+def test_product_is_scipys_bit_for_bit(threaded, monkeypatch):
+    if threaded:
+        monkeypatch.setattr(csr, "PARALLEL_MIN_NNZ", 0)
+    rng = np.random.default_rng(7)
+    for seed in range(3):
+        a = random_csr(seed)
+        x = rng.standard_normal(a.shape[1])
+        assert np.array_equal(CsrProduct(a)(x), a @ x)
+    # an assembled stiffness (skfem, int32 indices, sorted), as the explicit loop multiplies
+    m = skfem.MeshQuad.init_tensor(*[np.linspace(0.0, 1.0, 21)] * 2)
+    basis = skfem.Basis(m, skfem.ElementVector(skfem.ElementQuad1()))
+    k = skfem.asm(linear_elasticity(*lame_parameters(1e9, 0.3)), basis).tocsr()
+    x = rng.standard_normal(k.shape[1])
+    assert np.array_equal(CsrProduct(k)(x), k @ x)
+
+
+def test_product_keeps_its_own_copy_and_checks_the_vector():
+    a = random_csr(3)
+    product = CsrProduct(a)
+    x = np.ones(a.shape[1])
+    expected = a @ x
+    a.data[:] = 0.0  # a later change of the matrix is not seen (documented)
+    assert np.array_equal(product(x), expected)
+    with pytest.raises(ValueError, match=r"x must have shape \(250,\)"):
+        product(np.ones(a.shape[1] + 1))
