@@ -252,7 +252,7 @@ def test_warm_up_compiles_every_signature_the_taylor_bar_uses(geometry, model, n
 def test_cell_force_assembly_is_bincount_bit_for_bit(dim, nen):
     # the kernels' nodal assembly replaced np.bincount over the (component, node, cell)
     # arrays: the same additions in the same order, so the same floats (not merely close)
-    from arlequin.models.plasticity.j2_kernel import assemble_cell_forces
+    from arlequin.models.plasticity.j2_kernel import assemble_cell_forces, assembly_dofs
 
     rng = np.random.default_rng(3)
     ne, n_nodes = 57, 40
@@ -261,12 +261,12 @@ def test_cell_force_assembly_is_bincount_bit_for_bit(dim, nen):
     fe = rng.standard_normal((dim, nen, ne)) * 10.0 ** rng.integers(-8, 8, size=(dim, nen, ne))
     flags = np.zeros(ne, dtype=np.int64)
     f = np.full(dim * n_nodes + 3, np.nan)  # overwritten, trailing dofs of no cell included
-    assert assemble_cell_forces(cell_dofs, fe, flags, f) == 0
+    assert assemble_cell_forces(assembly_dofs(cell_dofs), fe, flags, f) == 0
     by_component = np.transpose(cell_dofs, (2, 1, 0))  # the model's (dim, nen, ne) layout
     expected = np.bincount(by_component.ravel(), weights=fe.ravel(), minlength=f.size)
     assert np.array_equal(f, expected)
     flags[[4, 30]] = (1, 2)
-    assert assemble_cell_forces(cell_dofs, fe, flags, f) == 2
+    assert assemble_cell_forces(assembly_dofs(cell_dofs), fe, flags, f) == 2
 
 
 def test_compiled_critical_step_is_the_numpy_estimate_bit_for_bit():

@@ -152,6 +152,7 @@ class FiniteStrainJ2(CellStates):
         self._assembler = None  # the tangent's sparse pattern, built at the first call
         self._tangent_static: tuple | None = None  # the tangent kernel's inputs and scratch
         self._cell_buffers: tuple | None = None  # the kernels' per-cell forces and flags
+        self._assembly: tuple | None = None  # (kernel dofs, their nodal assembly's layout)
         self._state_pool = ArrayPool()  # state arrays, reused once unreferenced
         self._constants: tuple | None = None  # K, G, law code and parameters of the kernels
         self._kernel_weight: tuple | None = None  # (α, its read-only view for the kernels)
@@ -510,11 +511,13 @@ class FiniteStrainJ2(CellStates):
     def _gathered(self, out: list[np.ndarray], cell_dofs: np.ndarray):
         """The kernel's outputs as (nodal force, PlasticState); flagged cells raise.
         ``cell_dofs`` (ne, nen, dim): the kernel's dofs of each cell's nodes."""
-        from .j2_kernel import assemble_cell_forces
+        from .j2_kernel import assemble_cell_forces, assembly_dofs
 
         fe, cp_inv, eqps, tau, J, wp, wv, flags = out
+        if self._assembly is None or self._assembly[0] is not cell_dofs:
+            self._assembly = (cell_dofs, assembly_dofs(cell_dofs))
         f = np.empty(self.kin.n_dofs)
-        if assemble_cell_forces(cell_dofs, fe, flags, f):
+        if assemble_cell_forces(self._assembly[1], fe, flags, f):
             bad = np.nonzero(flags)[0]
             cell = int(bad[0])
             if flags[cell] == 1:

@@ -21,7 +21,14 @@ import math
 import numba as nb
 import numpy as np
 
-from .j2_kernel import SQRT23, _flow, _plastic_multiplier, assemble_cell_forces, thread_slots
+from .j2_kernel import (
+    SQRT23,
+    _flow,
+    _plastic_multiplier,
+    assemble_cell_forces,
+    assembly_dofs,
+    thread_slots,
+)
 
 __all__ = ["solid_j2_kernel", "solid_scratch", "warm_up_solid"]
 
@@ -341,4 +348,4 @@ def warm_up_solid() -> None:
         np.array([1.0, 0.0, 0.0, 0.0, 0.0, 0.0]), 0.0, cp, zeros, zeros, zeros, ones,
         np.zeros(4), np.ones(ne), *solid_scratch(nq, nen), *out,
     )  # fmt: skip
-    assemble_cell_forces(dofs, out[0], out[-1], np.zeros(3 * nen))
+    assemble_cell_forces(assembly_dofs(dofs), out[0], out[-1], np.zeros(3 * nen))
