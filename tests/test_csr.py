@@ -1,6 +1,7 @@
 """The compiled CSR product (arlequin/solvers/csr.py) against scipy's ``A @ x``.
 
-The explicit loop's linear forces go through it, and the issue-30 rule is that the histories do
+The explicit loop's linear forces go through it (and its power sums through
+block_sums.py), and the issue-30 rule is that the histories do
 not change: so the products must be scipy's floats bit for bit (the same additions in the same
 order), not merely close, on the serial and on the threaded path.
 """
@@ -57,3 +58,21 @@ def test_product_keeps_its_own_copy_and_checks_the_vector():
     assert np.array_equal(product(x), expected)
     with pytest.raises(ValueError, match=r"x must have shape \(250,\)"):
         product(np.ones(a.shape[1] + 1))
+
+
+def test_signed_block_sums_are_the_bincount_sums():
+    # the explicit loop's per-block powers −Σ_{j∈b} f_j x_j over the touched dofs, compiled:
+    # the same additions in the same order as a weighted bincount, so the same floats
+    from arlequin.solvers.block_sums import signed_block_sums, touched_index
+
+    rng = np.random.default_rng(11)
+    n, n_blocks = 500, 4
+    block_of_dof = np.repeat(np.arange(n_blocks), n // n_blocks)
+    dofs = np.sort(rng.choice(n, 120, replace=False))
+    f = rng.standard_normal(dofs.size)
+    x = rng.standard_normal(n)
+    idx, block = touched_index(dofs, block_of_dof[dofs])
+    out = np.zeros(n_blocks)
+    signed_block_sums(f, x, idx, block, out)
+    expected = -np.bincount(block_of_dof[dofs], f * x[dofs], minlength=n_blocks)
+    assert np.array_equal(out, expected)

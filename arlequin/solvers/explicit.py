@@ -381,8 +381,7 @@ class CentralDifference(Integrator):
         vs = (v,) if v2 is None else (v, v2)
         nb = len(self.ops.blocks)
         if self.rows.m:
-            cols = self.rows.cols
-            eq = self.rows.block_powers_of(self._lam_e / self._dt_bar, [x[cols] for x in vs])
+            eq = self.rows.block_powers_of(self._lam_e / self._dt_bar, vs)
         else:
             eq = [(np.zeros(nb), np.zeros(nb)) for _ in vs]
         uni = unilateral_block_powers(self.ops, self._g_a, self._lam_a / self._dt_bar, vs) \

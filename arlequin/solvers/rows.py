@@ -18,6 +18,8 @@ import scipy.sparse as sp
 
 from ..contract import csr_pattern, csr_with_data, same_pattern
 from ..problem.system import LinearConstraint
+from .block_sums import signed_block_sums, touched_index
+from .csr import CsrProduct
 from .linalg import factor_checked
 from .operators import SystemOperators
 
@@ -215,12 +217,17 @@ def unilateral_block_powers(
     last = _TOUCHED[0]
     if not (last is g or (last is not None and same_pattern(last, g))):
         cols, inv = np.unique(g.indices, return_inverse=True)
-        _TOUCHED[0], _TOUCHED[1] = g, (cols, inv, np.repeat(np.arange(g.shape[0]),
-                                                            np.diff(g.indptr)))  # fmt: skip
-    cols, inv, row_of = _TOUCHED[1]
+        row_of = np.repeat(np.arange(g.shape[0]), np.diff(g.indptr))
+        index = touched_index(cols, ops.block_of_dof[cols])
+        _TOUCHED[0], _TOUCHED[1] = g, (cols, inv, row_of, *index)
+    cols, inv, row_of, idx, block = _TOUCHED[1]
     force = np.bincount(inv, g.data * lam[row_of], minlength=cols.size)
-    block = ops.block_of_dof[cols]
-    return [-np.bincount(block, force * x[cols], minlength=nb) for x in xs]
+    out = []
+    for x in xs:
+        p = np.zeros(nb)
+        signed_block_sums(force, x, idx, block, p)
+        out.append(p)
+    return out
 
 
 _TOUCHED: list[Any] = [None, None]  # the last rows of unilateral_block_powers, their dofs
@@ -289,7 +296,7 @@ class EqualityRows:
                 shape=(self.n_blocks * self.m, self.cols.size),
             )
         self._coupling_f = self.coupling.astype(float)
-        self._by_kind: list[tuple[np.ndarray, sp.csr_matrix]] | None = None
+        self._by_kind: list[tuple[np.ndarray, CsrProduct]] | None = None
         self._constant = all(not callable(c.rhs) for c in self.constraints)
         self._g0 = self._g(0.0) if self._constant else None
 
@@ -340,32 +347,34 @@ class EqualityRows:
         return pc, po
 
     def block_powers_of(
-        self, lam: np.ndarray, xs: Sequence[np.ndarray]
+        self, lam: np.ndarray, vs: Sequence[np.ndarray]
     ) -> list[tuple[np.ndarray, np.ndarray]]:
-        """:meth:`block_powers` for several vectors x (on :attr:`cols`) with the same
+        """:meth:`block_powers` for several vectors x (on every dof, (n,)) with the same
         multipliers, from the forces: ``−Σ_{j∈b} x_j (B_cᵀλ_c)_j`` and the same with the other
-        rows. The forces are computed once, then each x costs a product and a sum over the
-        touched dofs (the stacked rows' products, twice a step, cost 6% of an explicit step);
-        the same powers as :meth:`block_powers` up to round-off (the order of the sums)."""
+        rows. The forces are computed once (a kind of rows that is absent costs nothing), then
+        each x costs one compiled pass over the touched dofs
+        (:func:`~arlequin.solvers.block_sums.signed_block_sums`); the same powers as
+        :meth:`block_powers` up to round-off (the order of the sums)."""
         nb = self.n_blocks
         if self.m == 0:
-            return [(np.zeros(nb), np.zeros(nb)) for _ in xs]
+            return [(np.zeros(nb), np.zeros(nb)) for _ in vs]
         if self._by_kind is None:
-            # Bᵀ of the coupling rows and of the others, apart (made on first use)
+            # Bᵀ of the coupling rows and of the others, apart (made on first use), and the
+            # touched dofs with their blocks for the compiled sums
             kinds = (np.nonzero(self.coupling)[0], np.nonzero(~self.coupling)[0])
-            self._by_kind = [(r, self.matrix_cols[r].T.tocsr()) for r in kinds]
-            # the touched dofs are sorted and every block's dofs contiguous: per-block sums by
-            # reduceat over the blocks present (bincount with weights took 0.1 ms a step)
-            present, starts = np.unique(self.block_of_col, return_index=True)
-            self._block_sums = (present, starts)
-        f_c, f_o = (bt @ lam[r] for r, bt in self._by_kind)
-        present, starts = self._block_sums
+            self._by_kind = [(r, CsrProduct(self.matrix_cols[r].T.tocsr())) for r in kinds]
+            self._block_sums = touched_index(self.cols, self.block_of_col)
+        idx, block = self._block_sums
+        forces = [bt_times(lam[r]) if r.size else None for r, bt_times in self._by_kind]
         out = []
-        for x in xs:
-            pc, po = np.zeros(nb), np.zeros(nb)
-            pc[present] = -np.add.reduceat(f_c * x, starts)
-            po[present] = -np.add.reduceat(f_o * x, starts)
-            out.append((pc, po))
+        for x in vs:
+            pair = []
+            for f in forces:
+                p = np.zeros(nb)
+                if f is not None:
+                    signed_block_sums(f, x, idx, block, p)
+                pair.append(p)
+            out.append((pair[0], pair[1]))
         return out
 
     def row_name(self, i: int) -> str:
