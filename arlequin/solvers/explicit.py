@@ -228,10 +228,10 @@ class CentralDifference(Integrator):
         cols = rows.cols
         if rows.displacement.all():
             # B v* − (g − B u)/Δt = B (v* + u/Δt) − g/Δt: one product on the touched dofs
-            return rows.matrix_cols @ (v_star[cols] + u[cols] / dt) - rows.g(t_next) / dt
+            return rows.times(v_star[cols] + u[cols] / dt) - rows.g(t_next) / dt
         disp = rows.displacement
-        bv = rows.matrix_cols @ v_star[cols]
-        bu = rows.matrix_cols @ u[cols]
+        bv = rows.times(v_star[cols])
+        bu = rows.times(u[cols])
         g_end = rows.g(t_next)
         g_mid = rows.g(t_next - 0.5 * dt) if rows.time_dependent else g_end
         return bv - np.where(disp, (g_end - bu) / dt, g_mid)
@@ -255,7 +255,7 @@ class CentralDifference(Integrator):
             lam_e = solver.solve_equality(r_e)
             v_new = v_star
             if rows.m:
-                v_new[rows.cols] -= self._minv_cols * (rows.matrix_cols_t @ lam_e)
+                v_new[rows.cols] -= self._minv_cols * rows.transpose_times(lam_e)
             self.status_iterations = 0
             if timer is not None:
                 timer.linear_algebra += timer.clock() - tic
@@ -283,7 +283,7 @@ class CentralDifference(Integrator):
             lam_e, lam_a = solver.solve(r_e, g_a, r_a)
             v_new = v_star.copy()
             if rows.m:
-                v_new[rows.cols] -= self._minv_cols * (rows.matrix_cols_t @ lam_e)
+                v_new[rows.cols] -= self._minv_cols * rows.transpose_times(lam_e)
             if g_a.shape[0]:
                 push = transposed_times(g_a, lam_a)
                 push *= minv  # M⁻¹ Gᵀλ in Gᵀλ's own new array (commutative: the same bits)

@@ -21,6 +21,7 @@ from scipy.linalg.lapack import dpotrf, dpotrs
 from scipy.sparse.csgraph import connected_components
 
 from ..contract import ConstraintError
+from .csr import CsrProduct
 
 __all__ = [
     "DiagonalLowRankSolver",
@@ -346,6 +347,9 @@ class DiagonalLowRankSolver:
                     self._groups.append((idx, lu, False))
         self.shape = (b.shape[0], b.shape[0])
         self.k = k
+        # U and Uᵀ as compiled products for a right-hand side vector (scipy's floats)
+        self._u_times = CsrProduct(self.u)
+        self._u_t_times = CsrProduct(self.u_t)
 
     def decoupled_rows(self) -> tuple[np.ndarray, np.ndarray]:
         """(the rows coupled to no other in S: no shared column, their diagonal entries)."""
@@ -358,7 +362,8 @@ class DiagonalLowRankSolver:
         y = rhs / d
         if self.k == 0:
             return y
-        w = self.u_t @ y
+        vector = rhs.ndim == 1
+        w = self._u_t_times(y) if vector else self.u_t @ y
         if len(self._groups) == 1:
             _, fac, dense = self._groups[0]
             z = dense_cho_solve(fac, w) if dense else fac.solve(w)
@@ -366,7 +371,7 @@ class DiagonalLowRankSolver:
             z = np.empty_like(w)
             for idx, fac, dense in self._groups:
                 z[idx] = dense_cho_solve(fac, w[idx]) if dense else fac.solve(w[idx])
-        return y - (self.u @ z) / d
+        return y - (self._u_times(z) if vector else self.u @ z) / d
 
 
 def _diagonal_low_rank(b: sp.csr_matrix, pattern: sp.csr_matrix, counts: np.ndarray,

@@ -286,6 +286,10 @@ class EqualityRows:
         self.cols = np.unique(self.matrix.indices) if self.m else np.zeros(0, dtype=np.int64)
         self.matrix_cols = self.matrix[:, self.cols].tocsr() if self.m else sp.csr_matrix((0, 0))
         self.matrix_cols_t = self.matrix_cols.T.tocsr()
+        # B and Bᵀ on the touched dofs as compiled products (scipy's floats, without its
+        # dispatch: the explicit impulse multiplies by them at every step)
+        self.times = CsrProduct(self.matrix_cols)
+        self.transpose_times = CsrProduct(self.matrix_cols_t)
         self.block_of_col = ops.block_of_dof[self.cols]
         self.n_blocks = len(ops.blocks)
         # per-block row products in one mat-vec: row (b m + i) holds row i of B on block b's dofs

@@ -152,7 +152,7 @@ class FiniteStrainJ2(CellStates):
         self._assembler = None  # the tangent's sparse pattern, built at the first call
         self._tangent_static: tuple | None = None  # the tangent kernel's inputs and scratch
         self._cell_buffers: tuple | None = None  # the kernels' per-cell forces and flags
-        self._assembly: tuple | None = None  # (kernel dofs, their nodal assembly's layout)
+        self._assembly: tuple | None = None  # (kernel dofs, the nodal assembly's layout)
         self._state_pool = ArrayPool()  # state arrays, reused once unreferenced
         self._constants: tuple | None = None  # K, G, law code and parameters of the kernels
         self._kernel_weight: tuple | None = None  # (α, its read-only view for the kernels)
@@ -493,11 +493,10 @@ class FiniteStrainJ2(CellStates):
     def _kernel_outputs(self, dim: int) -> list[np.ndarray]:
         """The kernels' output buffers: forces, C_p⁻¹, ε̄p, τ, J, works, flags.
 
-        The per-cell forces and flags are the model's own (they never leave it). The state's
-        arrays come from a small pool: a set that nothing outside the pool references any more
-        (the states that held it are gone) is written over rather than allocated afresh. New
-        arrays are new pages: about 1,000 page faults per evaluation at nr = 30 (7 MB), which
-        cost as much as the kernel itself on the 2-core test machine.
+        The per-cell forces and flags are the model's own. The state's arrays come from a small
+        pool: a set nothing outside it references any more is written over rather than
+        allocated afresh (new arrays are new pages: about 1,000 page faults per evaluation at
+        nr = 30, which cost as much as the kernel on the 2-core test machine).
         """
         ne, nq = self.shape
         nen = self.kin.grad.shape[0]
@@ -509,8 +508,7 @@ class FiniteStrainJ2(CellStates):
         return [fe, *arrays, flags]
 
     def _gathered(self, out: list[np.ndarray], cell_dofs: np.ndarray):
-        """The kernel's outputs as (nodal force, PlasticState); flagged cells raise.
-        ``cell_dofs`` (ne, nen, dim): the kernel's dofs of each cell's nodes."""
+        """The kernel's outputs (its dofs ``cell_dofs``) as (force, state); flagged cells raise."""
         from .j2_kernel import assemble_cell_forces, assembly_dofs
 
         fe, cp_inv, eqps, tau, J, wp, wv, flags = out
@@ -521,9 +519,8 @@ class FiniteStrainJ2(CellStates):
             bad = np.nonzero(flags)[0]
             cell = int(bad[0])
             if flags[cell] == 1:
-                raise InvertedElementError(
-                    f"inverted or degenerate cell {cell}: det F <= 0 ({bad.size} such cells)"
-                )
+                msg = f"inverted or degenerate cell {cell}: det F <= 0 ({bad.size} such cells)"
+                raise InvertedElementError(msg)
             raise StateError(f"J2 return map not converged in cell {cell}")
         return f, PlasticState(cp_inv, eqps, tau, J, wp, wv)
 
