@@ -94,8 +94,9 @@ class CsrProduct:
         if x.shape != (self.shape[1],):
             raise ValueError(f"CsrProduct: x must have shape ({self.shape[1]},), got {x.shape}")
         y = np.empty(self.shape[0])
-        n_threads = nb.get_num_threads()
-        if self.nnz >= PARALLEL_MIN_NNZ and n_threads > 1:
+        # numba.get_num_threads() costs several µs (a Python-level launch check): only when
+        # the size may call for the threads
+        if self.nnz >= PARALLEL_MIN_NNZ and (n_threads := nb.get_num_threads()) > 1:
             _csr_times_parallel(self._indptr, self._indices, self._data, x, y, n_threads)
         else:
             csr_times(self._indptr, self._indices, self._data, x, y)

@@ -226,7 +226,7 @@ class CentralDifference(Integrator):
         rows = self.rows
         dt = self.dt
         cols = rows.cols
-        if rows.displacement.all():
+        if rows.all_displacement:
             # B v* − (g − B u)/Δt = B (v* + u/Δt) − g/Δt: one product on the touched dofs
             return rows.times(v_star[cols] + u[cols] / dt) - rows.g(t_next) / dt
         disp = rows.displacement

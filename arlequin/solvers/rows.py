@@ -282,6 +282,7 @@ class EqualityRows:
             disp.append(np.full(c.n_rows, c.level == "displacement"))
             coup.append(np.full(c.n_rows, c.kind == "coupling"))
         self.displacement = np.concatenate(disp) if disp else np.zeros(0, dtype=bool)
+        self.all_displacement = bool(self.displacement.all())  # every row: displacement level
         self.coupling = np.concatenate(coup) if coup else np.zeros(0, dtype=bool)
         self.cols = np.unique(self.matrix.indices) if self.m else np.zeros(0, dtype=np.int64)
         self.matrix_cols = self.matrix[:, self.cols].tocsr() if self.m else sp.csr_matrix((0, 0))

@@ -48,8 +48,13 @@ PARALLEL_MIN_CELLS = 256
 def run_kernel(kernel, n_cells: int, *args) -> None:
     """Call ``kernel(*args)``, on the calling thread alone when ``n_cells`` is below
     :data:`PARALLEL_MIN_CELLS` (numba's thread count is per calling thread and restored)."""
+    if n_cells >= PARALLEL_MIN_CELLS:
+        # no numba.get_num_threads() here: its launch check costs several µs a call (3% of an
+        # Arlequin Taylor bar step under py-spy)
+        kernel(*args)
+        return
     n = nb.get_num_threads()
-    if n_cells >= PARALLEL_MIN_CELLS or n == 1:
+    if n == 1:
         kernel(*args)
         return
     nb.set_num_threads(1)
