@@ -358,13 +358,17 @@ class EqualityRows:
             # reduceat over the blocks present (bincount with weights took 0.1 ms a step)
             present, starts = np.unique(self.block_of_col, return_index=True)
             self._block_sums = (present, starts)
-        f_c, f_o = (bt @ lam[r] for r, bt in self._by_kind)
+        # a kind without rows (often: no other rows than the coupling) has no force, so its
+        # powers stay zero without a product and its sums
+        f_c, f_o = (bt @ lam[r] if r.size else None for r, bt in self._by_kind)
         present, starts = self._block_sums
         out = []
         for x in xs:
             pc, po = np.zeros(nb), np.zeros(nb)
-            pc[present] = -np.add.reduceat(f_c * x, starts)
-            po[present] = -np.add.reduceat(f_o * x, starts)
+            if f_c is not None:
+                pc[present] = -np.add.reduceat(f_c * x, starts)
+            if f_o is not None:
+                po[present] = -np.add.reduceat(f_o * x, starts)
             out.append((pc, po))
         return out
 
