@@ -219,11 +219,15 @@ def unilateral_block_powers(
                                                             np.diff(g.indptr)))  # fmt: skip
     cols, inv, row_of = _TOUCHED[1]
     force = np.bincount(inv, g.data * lam[row_of], minlength=cols.size)
-    block = ops.block_of_dof[cols]
+    # the touched dofs' blocks, kept with those dofs (the same array object while they hold)
+    if not (_BLOCKS[0] is ops and _BLOCKS[1] is cols):
+        _BLOCKS[:] = [ops, cols, ops.block_of_dof[cols]]
+    block = _BLOCKS[2]
     return [-np.bincount(block, force * x[cols], minlength=nb) for x in xs]
 
 
 _TOUCHED: list[Any] = [None, None]  # the last rows of unilateral_block_powers, their dofs
+_BLOCKS: list[Any] = [None, None, None]  # the last operators, touched dofs and their blocks
 
 
 def _rate(c: LinearConstraint, t: float, h: float, order: int = 1) -> np.ndarray:
