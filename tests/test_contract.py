@@ -318,3 +318,17 @@ def test_csr_with_data_is_copy_of_template_with_new_data():
     hooked = Hooked(template)
     out = csr_with_data(hooked, data)
     assert Hooked.copies == 1 and type(out) is Hooked and out.data is data
+
+
+def test_csr_times_equals_scipy_product():
+    # rows.csr_times against scipy's @ (its reference: the same routine, so the same bits),
+    # and other operands (ints, a strided vector, a CSC matrix) through @ itself
+    import scipy.sparse as sp
+
+    from arlequin.solvers.rows import csr_times
+
+    a = sp.random(30, 50, density=0.2, format="csr", random_state=4)
+    x = np.random.default_rng(4).standard_normal(100)
+    for mat, vec in ((a, x[:50]), (a, x[::2]), (a.tocsc(), x[:50]), (a, np.arange(50))):
+        out = csr_times(mat, vec)
+        assert out.shape == (30,) and np.array_equal(out, mat @ vec)

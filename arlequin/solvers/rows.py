@@ -21,6 +21,11 @@ from ..problem.system import LinearConstraint
 from .linalg import factor_checked
 from .operators import SystemOperators
 
+try:  # scipy's own CSR mat-vec routine (the one its ``@`` calls for a vector)
+    from scipy.sparse._sparsetools import csr_matvec as _csr_matvec
+except ImportError:  # pragma: no cover - a scipy without it: its ``@``
+    _csr_matvec = None
+
 logger = logging.getLogger(__name__)
 
 __all__ = [
@@ -226,6 +231,25 @@ def unilateral_block_powers(
     return [-np.bincount(block, force * x[cols], minlength=nb) for x in xs]
 
 
+def csr_times(a: sp.csr_matrix, x: np.ndarray) -> np.ndarray:
+    """``a @ x`` (m,) of CSR rows a (m, n) of floats and a contiguous float vector x (n,) by
+    the routine scipy's ``@`` calls, without its dispatch (1.7 µs of each product, timeit):
+    the same numbers bit for bit; any other operands through ``@``."""
+    if (
+        _csr_matvec is None
+        or getattr(a, "format", None) != "csr"
+        or a.data.dtype != np.float64
+        or not isinstance(x, np.ndarray)
+        or x.dtype != np.float64
+        or x.shape != (a.shape[1],)
+        or not x.flags.c_contiguous
+    ):
+        return a @ x
+    y = np.zeros(a.shape[0])
+    _csr_matvec(a.shape[0], a.shape[1], a.indptr, a.indices, a.data, x, y)
+    return y
+
+
 _TOUCHED: list[Any] = [None, None]  # the last rows of unilateral_block_powers, their dofs
 _BLOCKS: list[Any] = [None, None, None]  # the last operators, touched dofs and their blocks
 
@@ -364,7 +388,7 @@ class EqualityRows:
             self._block_sums = (present, starts)
         # a kind without rows (often: no other rows than the coupling) has no force, so its
         # powers stay zero without a product and its sums
-        f_c, f_o = (bt @ lam[r] if r.size else None for r, bt in self._by_kind)
+        f_c, f_o = (csr_times(bt, lam[r]) if r.size else None for r, bt in self._by_kind)
         present, starts = self._block_sums
         out = []
         for x in xs:
