@@ -567,9 +567,29 @@ def csr_with_data(template: sp.csr_matrix, data: np.ndarray) -> sp.csr_matrix:
     may keep, stay as they were): a shallow copy of the template, 3.5 µs against 17 µs for
     scipy's constructor and its index checks (several matrices a step on a deforming contact).
     """
-    out = copy.copy(template)
+    cls = type(template)
+    if cls not in _PLAIN_COPY:
+        _PLAIN_COPY[cls] = _copies_dict_only(cls)
+    # copy.copy's own steps for such a class (a new instance, the attribute dict copied):
+    # 0.4 µs against 1.9 µs through __reduce_ex__
+    out = object.__new__(cls) if _PLAIN_COPY[cls] else copy.copy(template)
+    if _PLAIN_COPY[cls]:
+        out.__dict__.update(template.__dict__)
     out.data = data
     return out
+
+
+_PLAIN_COPY: dict[type, bool] = {}  # classes whose copy.copy is the attribute dict's copy
+
+
+def _copies_dict_only(cls: type) -> bool:
+    """Whether ``copy.copy`` of a ``cls`` instance copies its ``__dict__`` into a new one alone
+    (no copy hook, reduction, state method or slot but object's, and object's ``__new__``)."""
+    hooks = ("__copy__", "__reduce_ex__", "__reduce__", "__getstate__", "__setstate__")
+    for klass in cls.__mro__[:-1]:
+        if any(h in vars(klass) for h in hooks) or vars(klass).get("__slots__", ()):
+            return False
+    return cls.__new__ is object.__new__
 
 
 def same_pattern(a: sp.csr_matrix, b: sp.csr_matrix) -> bool:

@@ -287,3 +287,34 @@ def test_models_that_use_the_time_step_receive_it(scheme):
     assert sorted(set(model.seen[1:])) == sorted(set(steps))  # every later call: its step
     if scheme == "newmark":  # Newton's tangent: the same step as the force it derives
         assert model.seen_by_tangent and set(model.seen_by_tangent) <= set(steps)
+
+
+def test_csr_with_data_is_copy_of_template_with_new_data():
+    # csr_with_data's direct copy against copy.copy (its reference: the same attributes, the
+    # same objects), and a class with a __copy__ hook taking copy.copy's path
+    import scipy.sparse as sp
+
+    from arlequin.contract import csr_pattern, csr_with_data
+
+    indices, indptr = np.array([0, 2, 1], dtype=np.int32), np.array([0, 2, 3], dtype=np.int32)
+    template = csr_pattern(indices, indptr, (2, 3))
+    data = np.array([1.0, 2.0, 3.0])
+    out, ref = csr_with_data(template, data), copy.copy(template)
+    ref.data = data
+    assert type(out) is type(ref) and out.__dict__.keys() == ref.__dict__.keys()
+    assert all(out.__dict__[k] is ref.__dict__[k] for k in ref.__dict__)
+    assert np.array_equal(out.toarray(), [[1.0, 0.0, 2.0], [0.0, 3.0, 0.0]])
+    assert not template.data.any()  # the template keeps its zeros
+
+    class Hooked(sp.csr_matrix):
+        copies = 0
+
+        def __copy__(self):
+            type(self).copies += 1
+            new = Hooked.__new__(Hooked)
+            new.__dict__.update(self.__dict__)
+            return new
+
+    hooked = Hooked(template)
+    out = csr_with_data(hooked, data)
+    assert Hooked.copies == 1 and type(out) is Hooked and out.data is data

@@ -172,18 +172,19 @@ class CentralDifference(Integrator):
             Return the last estimate if it was made at most this many steps ago (0: estimate
             now).
         """
+        # the kept estimate first: most steps of a CriticalFraction controller end here
+        if (
+            max_age > 0
+            and self._critical_at is not None
+            and self._critical_now is not None
+            and self.step_count - self._critical_at < max_age
+        ):
+            return self._critical_now
         crit = self._stable().critical
         u = getattr(self, "u", None)
         if u is None:
             self._critical_now = crit
             return crit
-        if (
-            self._critical_now is not None
-            and self._critical_at is not None
-            and self.step_count - self._critical_at < max(max_age, 1)
-            and max_age > 0
-        ):
-            return self._critical_now
         self._critical_at = self.step_count
         ratio = 1.0
         for bi, b in enumerate(self.ops.blocks):
@@ -211,6 +212,8 @@ class CentralDifference(Integrator):
             stable = self._stable()
             # the latest estimate (a CriticalFraction controller refreshes it)
             now = self._critical_now if self._critical_now is not None else stable.critical
+            if dt <= now * (1.0 + 1e-12):
+                return dt  # check_time_step's test, without building a StableStep each step
             if now != stable.critical:
                 stable = StableStep(
                     now, stable.block_bound, stable.per_block, 2.0 / now, "current-configuration"
