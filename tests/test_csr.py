@@ -1,9 +1,9 @@
 """The compiled CSR product (arlequin/solvers/csr.py) against scipy's ``A @ x``.
 
-The explicit loop's linear forces go through it (and its power sums through
-block_sums.py), and the issue-30 rule is that the histories do
-not change: so the products must be scipy's floats bit for bit (the same additions in the same
-order), not merely close, on the serial and on the threaded path.
+The explicit loop's linear forces go through it (and its power sums through block_sums.py),
+and the issue-30 rule is that the histories do not change: so the products must be scipy's
+floats bit for bit (the same additions in the same order), not merely close, on the serial and
+on the threaded path.
 """
 
 from __future__ import annotations
