@@ -185,6 +185,42 @@ def test_interpolation_matrix_broadcasting_and_unlocated_rows():
     np.testing.assert_allclose(r[0].toarray(), p[0].toarray())
 
 
+def test_interpolation_matrix_stores_a_nested_patch_exactly():
+    # a 2:1 nested patch's nodes located in distorted coarse quads: each lies on a coarse vertex
+    # (one value, 1), on an edge midpoint (two, 1/2 each) or at a cell centre (four, 1/4 each).
+    # The located reference coordinates carry round-off (the inverse map's Newton iterations),
+    # which gave values of 1e-17 to 1e-14 where the basis vanishes: no such entry is stored,
+    # each row still sums to one, and the interpolant of an affine field is exact.
+    from arlequin.geometry.locate import locate_points
+    from arlequin.geometry.reference import FACE_SNAP, snapped_values
+
+    coarse = skfem.MeshQuad.init_tensor(np.linspace(0.0, 1.0, 5), np.linspace(0.0, 2.0, 9))
+    fine = coarse.refined(1)
+    # the same affine distortion for both: the fine nodes stay at the coarse edges' midpoints
+    stretch = np.array([[1.3, 0.4], [-0.2, 0.9]])
+    coarse = skfem.MeshQuad(stretch @ coarse.p, coarse.t)
+    fine = skfem.MeshQuad(stretch @ fine.p, fine.t)
+    loc = locate_points(coarse, fine.p)
+    assert loc.found.all()
+    p = interpolation_matrix(coarse, loc.cells, loc.ref)
+    counts = np.diff(p.indptr)
+    # expected: 45 coarse vertices (5 × 9), 4 × 9 + 5 × 8 = 76 edge midpoints, 32 cell centres
+    assert np.bincount(counts, minlength=5)[[1, 2, 4]].tolist() == [45, 76, 32]
+    assert np.abs(p.data).min() > FACE_SNAP
+    np.testing.assert_allclose(np.asarray(p.sum(axis=1)).ravel(), 1.0, rtol=0, atol=4e-16)
+    expected = {1: 1.0, 2: 0.5, 4: 0.25}
+    for k, value in expected.items():
+        rows = np.nonzero(counts == k)[0]
+        np.testing.assert_allclose(p[rows].toarray()[p[rows].toarray() != 0], value, atol=1e-14)
+    f = lambda x: 0.3 + 1.7 * x[0] - 0.6 * x[1]  # noqa: E731
+    np.testing.assert_allclose(p @ f(coarse.p), f(fine.p), rtol=0, atol=1e-14)
+    # values without a small one are returned unchanged, bit for bit
+    phi = np.array([[0.25, 0.5], [0.25, 1e-15], [0.25, 0.5 - 1e-15], [0.25, 0.0]])
+    out = snapped_values(phi)
+    assert np.array_equal(out[:, 0], phi[:, 0])
+    assert out[1, 1] == 0.0 and out[:, 1].sum() == 1.0
+
+
 def test_single_point_and_1d_flat_ref():
     mesh = make_mesh("line")
     # (dim,) is one point; for a 1D mesh a flat array is a row of points

@@ -44,6 +44,7 @@ from skfem import (
 from skfem.mesh import MeshHex1, MeshLine1, MeshQuad1, MeshTet1, MeshTri1
 
 __all__ = [
+    "FACE_SNAP",
     "ReferenceElement",
     "evaluate_basis",
     "interpolation_matrix",
@@ -52,6 +53,7 @@ __all__ = [
     "scalar_element_for",
     "shape_functions",
     "shape_gradients",
+    "snapped_values",
 ]
 
 
@@ -431,11 +433,42 @@ def interpolation_matrix(
     scipy.sparse.csr_matrix, shape (n_points, mesh.nvertices)
         Row ``k`` holds the basis values of ``cells[k]`` at ``ref[:, k]``, so ``P @ u``
         evaluates the nodal field ``u`` (shape (n_vertices,) or (n_vertices, m)) at the points.
+        Only the non-zero values are stored: a point on a face of its cell (to within
+        :data:`FACE_SNAP` in its basis values) is put on the face, see :func:`snapped_values`.
     """
     _, cells, ref = _prepare(mesh, cells, ref, n_points, allow_outside=True)
     n = cells.size
     keep = np.nonzero(cells >= 0)[0]
-    phi = shape_functions(mesh, ref[:, keep])  # (n_nodes, n_keep)
-    rows = np.broadcast_to(keep, phi.shape)
-    cols = mesh.t[:, cells[keep]]
-    return sp.csr_matrix((phi.ravel(), (rows.ravel(), cols.ravel())), shape=(n, mesh.nvertices))
+    phi = snapped_values(shape_functions(mesh, ref[:, keep]))  # (n_nodes, n_keep)
+    nonzero = phi != 0.0
+    rows = np.broadcast_to(keep, phi.shape)[nonzero]
+    cols = mesh.t[:, cells[keep]][nonzero]
+    return sp.csr_matrix((phi[nonzero], (rows, cols)), shape=(n, mesh.nvertices))
+
+
+#: Basis values of at most this size (dimensionless; the values lie in [0, 1] inside a cell) are
+#: taken for zeros by :func:`interpolation_matrix`: the round-off of a point located on a face
+#: of its cell (a nested patch's nodes on the coarse cells' edges came out at 1e-17 to 1e-14).
+FACE_SNAP = 1e-12
+
+
+def snapped_values(phi: np.ndarray) -> np.ndarray:
+    """First-order basis values ``phi`` (n_nodes, n_points) with the points within
+    :data:`FACE_SNAP` of a face of their cell put on it: the values of at most that size set to
+    zero and each such point's others divided by their sum (a partition of unity again).
+
+    Those values are round-off, not information: a point on a face (a nested patch's node on a
+    coarse edge) evaluates the face's nodes alone. Kept, they stored as many entries again in the
+    transfers and in the products built from them (the Taylor bar's coarse stiffness at 20 fine
+    cells across the radius: 72,726 entries, 41,044 of them below 1e-12 of the largest), which
+    the explicit loop multiplies at every step. The points with nothing that small are returned
+    unchanged, bit for bit.
+    """
+    small = (np.abs(phi) <= FACE_SNAP) & (phi != 0.0)
+    touched = np.nonzero(small.any(axis=0))[0]
+    if touched.size == 0:
+        return phi
+    phi = phi.copy()
+    part = np.where(small[:, touched], 0.0, phi[:, touched])
+    phi[:, touched] = part / part.sum(axis=0)
+    return phi
