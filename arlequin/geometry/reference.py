@@ -453,16 +453,26 @@ FACE_SNAP = 1e-12
 
 
 def snapped_values(phi: np.ndarray) -> np.ndarray:
-    """First-order basis values ``phi`` (n_nodes, n_points) with the points within
-    :data:`FACE_SNAP` of a face of their cell put on it: the values of at most that size set to
-    zero and each such point's others divided by their sum (a partition of unity again).
+    """First-order basis values with the points within :data:`FACE_SNAP` of a face of their
+    cell put on it: the values of at most that size set to zero and each such point's others
+    divided by their sum (a partition of unity again).
 
-    Those values are round-off, not information: a point on a face (a nested patch's node on a
-    coarse edge) evaluates the face's nodes alone. Kept, they stored as many entries again in the
-    transfers and in the products built from them (the Taylor bar's coarse stiffness at 20 fine
-    cells across the radius: 72,726 entries, 41,044 of them below 1e-12 of the largest), which
-    the explicit loop multiplies at every step. The points with nothing that small are returned
-    unchanged, bit for bit.
+    Those small values are round-off, not information: a point on a face (a nested patch's node
+    on a coarse edge) depends on the face's nodes alone. Kept, they nearly doubled the entries
+    of the transfers and of the operators built from them, which the explicit loop multiplies at
+    every step (the Arlequin Taylor bar's coarse stiffness at 20 fine cells across the radius:
+    72,726 entries, 41,044 of them below 1e-12 of the largest).
+
+    Parameters
+    ----------
+    phi : ndarray, shape (n_nodes, n_points)
+        Basis values at each point (dimensionless), as from :func:`shape_functions`.
+
+    Returns
+    -------
+    ndarray, shape (n_nodes, n_points)
+        ``phi`` itself when no point has a small non-zero value, else a copy in which only the
+        points that have one differ.
     """
     small = (np.abs(phi) <= FACE_SNAP) & (phi != 0.0)
     touched = np.nonzero(small.any(axis=0))[0]
