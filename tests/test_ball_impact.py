@@ -389,18 +389,49 @@ def test_a_bad_value_is_the_same_error_from_the_command_line_and_python(monkeypa
         assert f"error: {python.value}" in capsys.readouterr().err, argv
 
 
-def test_plastic_frames_carry_the_block_patch_plastic_strain(tmp_path):
+@pytest.fixture(scope="module")
+def rough_plastic_run(tmp_path_factory):
+    """The plastic impact on the ROUGH set-up with a results folder, and each of its recorder's
+    calls of ``block_energies``: (energies passed, its result, the result computed apart)."""
+    from arlequin.demos.ball_impact.setup import ImpactBodies
+
+    seen = []
+    computed = ImpactBodies.block_energies
+
+    def both(self, u, states, energies=None):
+        got = computed(self, u, states, energies)
+        seen.append((energies is not None, got, computed(self, u, states)))
+        return got
+
+    folder = tmp_path_factory.mktemp("plastic") / "run"
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(ImpactBodies, "block_energies", both)
+        r = run_ball_impact(regime="plastic", block_radius=0.02, block_height=0.02,
+                            out=folder, **ROUGH)  # fmt: skip
+    return r, folder, seen
+
+
+def test_the_recorder_takes_the_j2_energies_from_the_integrators(rough_plastic_run):
+    # the recorder passes the integrator's energies to block_energies, which takes the J2
+    # block's stored energy and dissipation from them (the same model calls on the same state)
+    # instead of computing them again: at every sample, the same floats as computed apart
+    r, _, seen = rough_plastic_run
+    assert len(seen) > 100 and all(passed for passed, _, _ in seen)
+    assert all(got == apart for _, got, apart in seen)
+    assert r.max_plastic_strain > 0.0 and seen[-1][1][1] > 0.0  # plastic flow dissipated
+
+
+def test_plastic_frames_carry_the_block_patch_plastic_strain(rough_plastic_run):
     # the results folder's block patch series: ε̄p and the von Mises stress (cell means of the
     # J2 states) beside α in every frame, with their units in results.json; the last frame's
     # largest cell mean is at most the run's largest ε̄p at a quadrature point, and positive
     import meshio
 
-    r = run_ball_impact(regime="plastic", block_radius=0.02, block_height=0.02,
-                        out=tmp_path / "run", **ROUGH)  # fmt: skip
-    meta = json.loads((tmp_path / "run" / "results.json").read_text())
+    r, folder, _ = rough_plastic_run
+    meta = json.loads((folder / "results.json").read_text())
     assert meta["field_units"]["plastic_strain"] == "1"
     assert meta["field_units"]["von_mises"] == "Pa"
-    with meshio.xdmf.TimeSeriesReader(str(tmp_path / "run" / "fields" / "block.patch.xdmf")) as f:
+    with meshio.xdmf.TimeSeriesReader(str(folder / "fields" / "block.patch.xdmf")) as f:
         f.read_points_cells()
         assert f.num_steps == 10
         _, _, cells = f.read_data(f.num_steps - 1)

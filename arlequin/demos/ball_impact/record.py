@@ -108,7 +108,7 @@ class ImpactRecorder:
         elastic, plastic = strain, 0.0
         if self._j2_block is not None:
             # the J2 block's strain is its internal work: its elastic part and its dissipation
-            stored, plastic = b.block_energies(integ.u, integ.states)
+            stored, plastic = b.block_energies(integ.u, integ.states, e)
             elastic = strain - e["strain"][self._j2_block] + stored
         row = {"t": integ.t, "contact_force": force,
                "ball_velocity": b.ball_velocity(integ.v), "kinetic": kinetic,

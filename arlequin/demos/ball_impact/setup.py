@@ -362,12 +362,25 @@ class ImpactBodies:
         term = self.system.block(self.block_block).terms[0]
         return term.model, self.block_block, 0, term.weight, None
 
-    def block_energies(self, u: np.ndarray, states: dict) -> tuple[float, float]:
-        """(elastic energy, plastic dissipation) (J) of the block carrying the J2 law."""
+    def block_energies(self, u: np.ndarray, states: dict,
+                       energies: dict | None = None) -> tuple[float, float]:  # fmt: skip
+        """(elastic energy, plastic dissipation) (J) of the block carrying the J2 law.
+
+        ``energies``: the integrator's :meth:`~arlequin.solvers.base.Integrator.energies` at
+        the same state, if the caller has them. When the J2 law is its block's only term
+        (not ``mono-zoned``) and has no bulk viscosity, the block's ``stored`` and
+        ``dissipation`` there are these numbers (the same calls on the same state): taken
+        from them rather than computed twice.
+        """
         part = self.plastic_part()
         if part is None:
             return 0.0, 0.0
         model, block, index, weight, _ = part
+        terms = self.system.block(block).terms
+        if (energies is not None and self.zoned is None
+                and not getattr(model, "bulk_viscosity", None)
+                and len(terms) == 1 and terms[0].sign == 1):  # fmt: skip
+            return energies["stored"][block], energies["dissipation"][block]
         ub = u[self.system.dofmap[block].slice]
         state = states[block][index]
         # the committed state is the one at u: its own τ gives ψ (no kinematics)
