@@ -433,8 +433,8 @@ def interpolation_matrix(
     scipy.sparse.csr_matrix, shape (n_points, mesh.nvertices)
         Row ``k`` holds the basis values of ``cells[k]`` at ``ref[:, k]``, so ``P @ u``
         evaluates the nodal field ``u`` (shape (n_vertices,) or (n_vertices, m)) at the points.
-        Only the non-zero values are stored: a point on a face of its cell (to within
-        :data:`FACE_SNAP` in its basis values) is put on the face, see :func:`snapped_values`.
+        Only the non-zero values are stored, values of at most :data:`FACE_SNAP` being taken
+        for zeros (the round-off of a point on a face of its cell), see :func:`snapped_values`.
     """
     _, cells, ref = _prepare(mesh, cells, ref, n_points, allow_outside=True)
     n = cells.size
@@ -453,15 +453,18 @@ FACE_SNAP = 1e-12
 
 
 def snapped_values(phi: np.ndarray) -> np.ndarray:
-    """First-order basis values with the points within :data:`FACE_SNAP` of a face of their
-    cell put on it: the values of at most that size set to zero and each such point's others
-    divided by their sum (a partition of unity again).
+    """First-order basis values with those of at most :data:`FACE_SNAP` set to zero and each
+    such point's others divided by their sum (a partition of unity again).
 
-    Those small values are round-off, not information: a point on a face (a nested patch's node
-    on a coarse edge) depends on the face's nodes alone. Kept, they nearly doubled the entries
-    of the transfers and of the operators built from them, which the explicit loop multiplies at
-    every step (the Arlequin Taylor bar's coarse stiffness at 20 fine cells across the radius:
-    72,726 entries, 41,044 of them below 1e-12 of the largest).
+    At a point on a face of its cell (a nested patch's node on a coarse edge) the values of the
+    nodes off the face vanish, and what the located reference coordinates give there is
+    round-off: the point then depends on the face's nodes alone. (A value that small elsewhere,
+    e.g. a Q1 corner's at 1e-6 from two faces, is dropped too: the point's values change by at
+    most about 1e-11, as if it moved by that fraction of its cell.) Kept, those round-off
+    values nearly doubled the entries of the transfers and of the operators built from them,
+    which the explicit loop multiplies at every step (the Arlequin Taylor bar's coarse
+    stiffness at 20 fine cells across the radius: 72,726 entries, 41,044 of them below 1e-12 of
+    the largest).
 
     Parameters
     ----------
