@@ -104,6 +104,62 @@ def test_multipliers_mapping_copies_and_pickles_as_a_plain_dict(ball):
         mult["nope"]
 
 
+def test_many_samples_convert_in_one_solve_to_the_numbers_of_each(ball):
+    # a per-step history keeps the scheme's stacked multipliers and converts k steps at once:
+    # bit for bit each step's own conversion, for every constraint (the axis rows that the
+    # single-dof elimination touches included)
+    ops = SystemOperators(ball.system, lumped=True)
+    basis = ImpulseBasis(ball.system.constraints, ops)
+    lam = np.random.default_rng(4).standard_normal((7, basis.rows.m))
+    batch = basis.to_original(lam)
+    for k in range(lam.shape[0]):
+        np.testing.assert_array_equal(batch[k], basis.to_original(lam[k]))
+    mults = [basis.multipliers(x) for x in lam]
+    stacked = np.vstack([m.stacked_in_scheme_basis() for m in mults])
+    np.testing.assert_array_equal(stacked, lam)
+    for name in basis.original.slices:
+        assert mults[0].converted(name)
+        got = mults[-1].to_original(name, stacked)
+        for k, m in enumerate(mults):
+            np.testing.assert_array_equal(got[k], m[name])
+    mults[0]["contact"] = np.ones(3)
+    assert not mults[0].converted("contact") and not mults[0].converted("nope")
+
+
+def test_taylor_multiplier_history_converts_by_chunks_to_the_per_step_numbers(ball):
+    # MultiplierHistory keeps the scheme's multipliers and converts them by chunks: the same
+    # float32 rows as converting each step (its former way), across chunk boundaries and
+    # through a checkpoint's state and restore
+    from types import SimpleNamespace
+
+    from arlequin.demos.taylor_bar.record import MultiplierHistory
+
+    ops = SystemOperators(ball.system, lumped=True)
+    basis = ImpulseBasis(ball.system.constraints, ops)
+    name = "ball.dirichlet:patch:1"  # converted through the single-dof rows
+    hist = MultiplierHistory(name)
+    hist.chunk = 4
+    lam = np.random.default_rng(5).standard_normal((11, basis.rows.m))
+    expected = []
+    for k, x in enumerate(lam):
+        m = basis.multipliers(x)
+        expected.append(np.asarray(m[name], dtype=np.float32))
+        hist(SimpleNamespace(multipliers=m))
+        if k == 5:  # a checkpoint mid-chunk, restored into a new history
+            again = MultiplierHistory(name)
+            again.chunk = 4
+            again.restore(pickle.loads(pickle.dumps(hist.state())))
+            hist = again
+    got = hist.array()
+    assert got.dtype == np.float32 and not got.flags.writeable
+    np.testing.assert_array_equal(got, np.vstack(expected))
+    # a plain dict of multipliers (no rewritten rows): kept as given
+    plain = MultiplierHistory("c")
+    for x in lam[:3]:
+        plain(SimpleNamespace(multipliers={"c": x[:5]}))
+    np.testing.assert_array_equal(plain.array(), lam[:3, :5].astype(np.float32))
+
+
 @pytest.mark.parametrize("dim", ["2", "axi", "3"])
 @pytest.mark.parametrize("coupling", ["L2", "H1"])
 def test_patch_test_rows_nested_reduce_nonnested_stay(dim, coupling):
