@@ -49,6 +49,22 @@ def test_product_is_scipys_bit_for_bit(threaded, monkeypatch):
     assert np.array_equal(CsrProduct(k)(x), k @ x)
 
 
+def test_product_of_gathered_vectors_is_the_product_of_their_gather():
+    # the explicit impulse's B (v + u/Δt) on the rows' dofs: the sum formed inside the product,
+    # the floats of the gathers, the division, the sum and the product made apart
+    rng = np.random.default_rng(8)
+    a = random_csr(4)
+    n = 1000
+    cols = np.sort(rng.choice(n, a.shape[1], replace=False))
+    x, z = rng.standard_normal(n), rng.standard_normal(n) * 1e-3
+    dt = 3.7e-9
+    product = CsrProduct(a)
+    expected = a @ (x[cols] + z[cols] / dt)
+    assert np.array_equal(product.times_gathered(cols.astype(np.uint32), x, z, dt), expected)
+    with pytest.raises(ValueError, match="cols must be uint32"):
+        product.times_gathered(cols, x, z, dt)
+
+
 def test_product_keeps_its_own_copy_and_checks_the_vector():
     a = random_csr(3)
     product = CsrProduct(a)
@@ -75,4 +91,15 @@ def test_signed_block_sums_are_the_bincount_sums():
     out = np.zeros(n_blocks)
     signed_block_sums(f, x, idx, block, out)
     expected = -np.bincount(block_of_dof[dofs], f * x[dofs], minlength=n_blocks)
+    assert np.array_equal(out, expected)
+    # dofs in any order (blocks interleaved) and a non-zero start: the kernel's register sums
+    # make the subtractions of the plain loop ``out[block[k]] -= f_k x_idx[k]``, in its order
+    shuffled = rng.permutation(dofs.size)
+    idx, block = touched_index(dofs[shuffled], block_of_dof[dofs[shuffled]])
+    start = rng.standard_normal(n_blocks)
+    out = start.copy()
+    signed_block_sums(f[shuffled], x, idx, block, out)
+    expected = start.copy()
+    for k in range(idx.size):
+        expected[block[k]] -= f[shuffled][k] * x[idx[k]]
     assert np.array_equal(out, expected)

@@ -33,8 +33,22 @@ def signed_block_sums(values, x, idx, block, out):
     out : ndarray, shape (n_blocks,)
         Accumulated into (W or J).
     """
+    # each block's running sum in a register while its dofs follow each other (the touched
+    # dofs come sorted, so by block): the same subtractions in the same order as
+    # ``out[block[k]] -= ...`` per k, without a store and reload of out[block[k]] in the
+    # dependency chain of every term (10 µs against 4 µs on the ball impact's 2,863 dofs)
+    current = -1
+    acc = 0.0
     for k in range(values.size):
-        out[block[k]] -= values[k] * x[idx[k]]
+        b = block[k]
+        if b != current:
+            if current >= 0:
+                out[current] = acc
+            current = b
+            acc = out[b]
+        acc -= values[k] * x[idx[k]]
+    if current >= 0:
+        out[current] = acc
 
 
 def touched_index(dofs: np.ndarray, blocks: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -19,7 +19,7 @@ import numba as nb
 import numpy as np
 import scipy.sparse as sp
 
-__all__ = ["PARALLEL_MIN_NNZ", "CsrProduct", "csr_times"]
+__all__ = ["PARALLEL_MIN_NNZ", "CsrProduct", "csr_times", "csr_times_gathered"]
 
 #: From this many stored entries the product runs on numba's threads. Waking the sleeping worker
 #: costs tens of µs: a product of 58k entries (22 µs on one core) does not repay it, one of 925k
@@ -48,6 +48,32 @@ def csr_times(indptr, indices, data, x, y):
         for k in range(indptr[i], indptr[i + 1]):
             s += data[k] * x[indices[k]]
         y[i] = s
+
+
+@nb.njit(cache=True)
+def csr_times_gathered(indptr, indices, data, cols, x, z, divisor, w, y):
+    """y = A w with ``w = x[cols] + z[cols] / divisor``, w formed in a scratch vector: the
+    floats of :func:`csr_times` on that w (each w_j the same two operations), without numpy's
+    gathers and temporaries.
+
+    Parameters
+    ----------
+    indptr, indices, data
+        A in CSR form, as :func:`csr_times`.
+    cols : ndarray of uint32, shape (n_cols,)
+        The entries of x and z that A's columns stand for.
+    x, z : ndarray of float64
+        Full-size vectors.
+    divisor : float
+    w : ndarray of float64, shape (n_cols,)
+        Scratch (overwritten).
+    y : ndarray of float64, shape (n_rows,)
+        Output (overwritten).
+    """
+    for j in range(cols.size):
+        c = cols[j]
+        w[j] = x[c] + z[c] / divisor
+    csr_times(indptr, indices, data, w, y)
 
 
 @nb.njit(parallel=True, cache=True)
@@ -87,6 +113,7 @@ class CsrProduct:
         self._indptr = np.ascontiguousarray(a.indptr, dtype=np.uint64)
         self._indices = np.ascontiguousarray(a.indices, dtype=np.uint32)
         self._data = np.array(a.data, dtype=np.float64)
+        self._scratch: np.ndarray | None = None  # times_gathered's vector (n_cols,)
 
     def __call__(self, x: np.ndarray) -> np.ndarray:
         """A x, a new array (n_rows,), bit for bit scipy's ``A @ x`` for a float64 vector x."""
@@ -100,4 +127,30 @@ class CsrProduct:
             _csr_times_parallel(self._indptr, self._indices, self._data, x, y, n_threads)
         else:
             csr_times(self._indptr, self._indices, self._data, x, y)
+        return y
+
+    def times_gathered(self, cols: np.ndarray, x: np.ndarray, z: np.ndarray,
+                       divisor: float) -> np.ndarray:  # fmt: skip
+        """``A (x[cols] + z[cols] / divisor)`` (n_rows,), the same floats as
+        ``self(x[cols] + z[cols] / divisor)`` (:func:`csr_times_gathered`): e.g. the rows'
+        ``B (v + u/Δt)`` of the explicit impulse on the dofs they touch.
+
+        Parameters
+        ----------
+        cols : ndarray of uint32, shape (n_cols,)
+            The full vectors' entries of A's columns (unsigned: no wraparound test).
+        x, z : ndarray of float64
+            Full-size vectors.
+        divisor : float
+        """
+        if cols.shape != (self.shape[1],) or cols.dtype != np.uint32:
+            raise ValueError(f"CsrProduct: cols must be uint32 of shape ({self.shape[1]},), got "
+                             f"{cols.dtype} {cols.shape}")  # fmt: skip
+        y = np.empty(self.shape[0])
+        x = np.ascontiguousarray(x, dtype=np.float64)
+        z = np.ascontiguousarray(z, dtype=np.float64)
+        if self._scratch is None:
+            self._scratch = np.empty(self.shape[1])
+        csr_times_gathered(self._indptr, self._indices, self._data, cols, x, z, float(divisor),
+                           self._scratch, y)  # fmt: skip
         return y

@@ -230,8 +230,13 @@ class CentralDifference(Integrator):
         dt = self.dt
         cols = rows.cols
         if rows.all_displacement:
-            # B v* − (g − B u)/Δt = B (v* + u/Δt) − g/Δt: one product on the touched dofs
-            return rows.times(v_star[cols] + u[cols] / dt) - rows.g(t_next) / dt
+            # B v* − (g − B u)/Δt = B (v* + u/Δt) − g/Δt: one product on the touched dofs,
+            # v* + u/Δt formed inside it (the same floats as the gathers' and the sum's)
+            if rows.cols_u32 is not None:
+                bw = rows.times.times_gathered(rows.cols_u32, v_star, u, dt)
+            else:
+                bw = rows.times(v_star[cols] + u[cols] / dt)
+            return bw - rows.g(t_next) / dt
         disp = rows.displacement
         bv = rows.times(v_star[cols])
         bu = rows.times(u[cols])

@@ -290,6 +290,9 @@ class EqualityRows:
         # B and Bᵀ on the touched dofs as compiled products (scipy's floats, without its
         # dispatch: the explicit impulse multiplies by them at every step)
         self.times = CsrProduct(self.matrix_cols)
+        # the touched dofs as the compiled products' column map (uint32: no wraparound test)
+        self.cols_u32 = np.ascontiguousarray(self.cols, dtype=np.uint32) \
+            if self.cols.size and self.cols.max() < 2**32 else None  # fmt: skip
         self.transpose_times = CsrProduct(self.matrix_cols_t)
         self.block_of_col = ops.block_of_dof[self.cols]
         self.n_blocks = len(ops.blocks)
