@@ -324,7 +324,7 @@ def test_thread_scratch_slots_start_on_their_own_cache_lines():
         for t in range(slots.shape[0]):
             assert slots[t].ctypes.data % 128 == 0
     for arrays, shapes in [
-        (scratch(4, 4), [(4, 6), (4, 4, 3), (4, 4)]),
+        (scratch(4, 4), [(4, 10), (4, 4, 3), (4, 4)]),
         (solid_scratch(8, 8), [(8, 19), (9, 8, 3), (4, 3, 3)]),
         (tangent_scratch(4, 4, 2), [(4, 19), (4, 4, 4), (4, 3, 3), (3, 3, 3, 3), (3, 3, 4, 2),
                                     (9, 8)]),
