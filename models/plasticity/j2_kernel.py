@@ -231,7 +231,10 @@ def _plastic_multiplier(norm, eqps, code, prm, G, dt):
     return -1.0  # not converged: flagged by the caller
 
 
-@nb.njit(parallel=True, cache=True, error_model="numpy", fastmath={"contract"})
+# fastmath: contraction into fused multiply-adds, and "arcp" (a division may become a product
+# with a reciprocal, one reciprocal serving several divisions by the same value): outputs
+# within 5e-16 of the kernel without it, 5% faster on one core at nr = 30 (same process)
+@nb.njit(parallel=True, cache=True, error_model="numpy", fastmath={"contract", "arcp"})
 def planar_j2_kernel(
     u, cell_dofs, grad, val, radius, dv0, alpha, axi, fbar, K, G, code, prm, dt,
     cp_inv, eqps, wp, wv, jac_old, visc, h0, scratch_h, scratch_g, scratch_u,
