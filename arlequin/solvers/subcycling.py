@@ -274,8 +274,10 @@ class SubcycledCentralDifference(CentralDifference):
         self._plan_h = self.dt
         self._big_prev = 0.0
         self._big_cur = 0.0
-        # M⁻¹ f_slow (m/s²) on the slow dofs, in the order of _slow_ranges
-        self._minv_f_slow = np.zeros(int(self._slow.sum()))
+        # the internal force of the last macro time (N) and M⁻¹ f_slow (m/s²) on the slow dofs
+        # in the order of _slow_ranges, made from it when a kick needs it (None until then)
+        self._slow_force = np.zeros(self.ops.n)
+        self._minv_f_slow: np.ndarray | None = None
         self._starting = True  # the forces at t0 are those of a macro time
         super()._initialize()
         self._starting = False
@@ -285,7 +287,8 @@ class SubcycledCentralDifference(CentralDifference):
 
     def _scheme_fields(self) -> tuple[str, ...]:
         return (*super()._scheme_fields(), "_j", "_m_n", "_plan_h", "_big_prev", "_big_cur",
-                "_minv_f_slow", "macro_steps", "ratios", "_energy_scale")  # fmt: skip
+                "_slow_force", "_minv_f_slow", "macro_steps", "ratios",
+                "_energy_scale")  # fmt: skip
 
     def _kinetic(self) -> np.ndarray:
         """½ ṽ⁻·M v⁺ per block; at a macro time the slow dofs' ṽ⁻ uses the macro steps."""
@@ -326,9 +329,8 @@ class SubcycledCentralDifference(CentralDifference):
         macro_time = self._starting or self._j + 1 == self._m_n
         if macro_time:
             f_int, f_ext, trial = super()._forces(u, t, dt)
-            minv = self.ops.inv_mass
-            parts = [minv[sl] * f_int[sl] for sl in self._slow_ranges]
-            self._minv_f_slow = parts[0] if len(parts) == 1 else np.concatenate(parts)
+            self._slow_force = f_int  # never modified in place (read by the kick and the works)
+            self._minv_f_slow = None
             return f_int, f_ext, trial
         return super()._forces(u, t, dt, blocks=self._fast_b)
 
@@ -339,11 +341,16 @@ class SubcycledCentralDifference(CentralDifference):
             # the slow internal force acts as one impulse H̄ f_slow instead of h̄ f_slow
             big_bar = 0.5 * (self._big_prev + self._m_n * self.dt)
             scale = big_bar - dt_bar
-            start = 0
-            for sl in self._slow_ranges:  # the slow dofs only (zero force elsewhere)
-                stop = start + sl.stop - sl.start
-                v_star[sl] -= scale * self._minv_f_slow[start:stop]
-                start = stop
+            if scale != 0.0:  # zero while the macro steps are single fine steps (m = 1)
+                if self._minv_f_slow is None:
+                    minv, f = self.ops.inv_mass, self._slow_force
+                    parts = [minv[sl] * f[sl] for sl in self._slow_ranges]
+                    self._minv_f_slow = parts[0] if len(parts) == 1 else np.concatenate(parts)
+                start = 0
+                for sl in self._slow_ranges:  # the slow dofs only (zero force elsewhere)
+                    stop = start + sl.stop - sl.start
+                    v_star[sl] -= scale * self._minv_f_slow[start:stop]
+                    start = stop
         return v_star
 
     def _step_impl(self) -> None:
