@@ -63,6 +63,9 @@ def test_product_of_gathered_vectors_is_the_product_of_their_gather():
     assert np.array_equal(product.times_gathered(cols.astype(np.uint32), x, z, dt), expected)
     with pytest.raises(ValueError, match="cols must be uint32"):
         product.times_gathered(cols, x, z, dt)
+    # the compiled loop reads x and z unchecked: vectors too short are refused first
+    with pytest.raises(ValueError, match="x and z must be vectors"):
+        product.times_gathered(cols.astype(np.uint32), x[: cols.max()], z[: cols.max()], dt)
 
 
 def test_product_keeps_its_own_copy_and_checks_the_vector():

@@ -158,6 +158,7 @@ def test_taylor_multiplier_history_converts_by_chunks_to_the_per_step_numbers(ba
     for x in lam[:3]:
         plain(SimpleNamespace(multipliers={"c": x[:5]}))
     np.testing.assert_array_equal(plain.array(), lam[:3, :5].astype(np.float32))
+    assert not plain.array().flags.writeable  # one block, handed out read-only too
 
 
 @pytest.mark.parametrize("dim", ["2", "axi", "3"])

@@ -50,7 +50,7 @@ def csr_times(indptr, indices, data, x, y):
         y[i] = s
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, error_model="numpy")
 def csr_times_gathered(indptr, indices, data, cols, x, z, divisor, w, y):
     """y = A w with ``w = x[cols] + z[cols] / divisor``, w formed in a scratch vector: the
     floats of :func:`csr_times` on that w (each w_j the same two operations), without numpy's
@@ -114,6 +114,7 @@ class CsrProduct:
         self._indices = np.ascontiguousarray(a.indices, dtype=np.uint32)
         self._data = np.array(a.data, dtype=np.float64)
         self._scratch: np.ndarray | None = None  # times_gathered's vector (n_cols,)
+        self._cols_max: tuple[np.ndarray, int] | None = None  # its last cols, their largest
 
     def __call__(self, x: np.ndarray) -> np.ndarray:
         """A x, a new array (n_rows,), bit for bit scipy's ``A @ x`` for a float64 vector x."""
@@ -146,9 +147,16 @@ class CsrProduct:
         if cols.shape != (self.shape[1],) or cols.dtype != np.uint32:
             raise ValueError(f"CsrProduct: cols must be uint32 of shape ({self.shape[1]},), got "
                              f"{cols.dtype} {cols.shape}")  # fmt: skip
-        y = np.empty(self.shape[0])
         x = np.ascontiguousarray(x, dtype=np.float64)
         z = np.ascontiguousarray(z, dtype=np.float64)
+        # the compiled loop reads x and z unchecked: their size against the largest column
+        # (kept for the last cols array, the same one at every step)
+        if self._cols_max is None or self._cols_max[0] is not cols:
+            self._cols_max = (cols, int(cols.max()) if cols.size else -1)
+        if x.ndim != 1 or x.shape != z.shape or x.size <= self._cols_max[1]:
+            raise ValueError(f"CsrProduct: x and z must be vectors of one size above "
+                             f"{self._cols_max[1]}, got {x.shape} and {z.shape}")  # fmt: skip
+        y = np.empty(self.shape[0])
         if self._scratch is None:
             self._scratch = np.empty(self.shape[1])
         csr_times_gathered(self._indptr, self._indices, self._data, cols, x, z, float(divisor),

@@ -407,7 +407,8 @@ class DiagonalLowRankSolver:
         Raises
         ------
         ValueError
-            If ``rhs`` has a non-finite entry.
+            If ``rhs`` has a non-finite entry (the compiled vector path tests ``rhs`` itself;
+            the others the vector Uᵀ D⁻¹ rhs, as LAPACK's wrapper does).
         """
         if rhs.ndim == 1 and self._compiled is not None:
             out = np.empty(self.shape[0])

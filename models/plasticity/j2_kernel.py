@@ -263,6 +263,8 @@ def planar_j2_kernel(
     nen = 4
     if grad.shape[1] != nq or grad.shape[2] != nen:
         raise ValueError("planar_j2_kernel: Q1 cells with 2 x 2 Gauss points only")
+    if scratch_h.shape[1] < nq or scratch_h.shape[2] < 10:
+        raise ValueError("planar_j2_kernel: scratch_h must hold (n_threads, 4, 10) (scratch())")
     third = 1.0 / 3.0
     for e in nb.prange(ne):
         flags[e] = 0

@@ -27,7 +27,8 @@ logger = logging.getLogger(__name__)
 #: The checkpoint's file name in the results folder.
 CHECKPOINT = "checkpoint.pkl"
 
-_FORMAT = 1
+# 2: the multi-time-step integrator's snapshot keeps its slow force by dof ranges
+_FORMAT = 2
 
 
 class CheckpointWriter:

@@ -234,9 +234,8 @@ class MultiplierHistory:
         if not self._blocks:
             return np.zeros((0, 0), dtype=np.float32)
         if len(self._blocks) > 1:  # one block from now on
-            whole = np.vstack(self._blocks)
-            whole.flags.writeable = False  # handed out as it is
-            self._blocks = [whole]
+            self._blocks = [np.vstack(self._blocks)]
+        self._blocks[0].flags.writeable = False  # handed out as it is
         return self._blocks[0]
 
     def chatter(self) -> dict[str, float]:
