@@ -232,17 +232,6 @@ class ImpulseBasis:
                 out[r.single_rows] -= r.r_j_scaled.T @ lam_r
         return out
 
-    def constraint_to_original(self, name: str, lam: np.ndarray) -> np.ndarray:
-        """One rewritten constraint's multipliers in the original basis from its own in the
-        scheme's: shape (m_c,) or (k, m_c) for k samples (T⁻ᵀ applied to each)."""
-        for r in self._reduced:
-            if r.name == name:
-                x = np.asarray(lam, dtype=float)
-                if x.ndim == 1:
-                    return r.t_lu.solve(np.ascontiguousarray(x), trans="T")
-                return r.t_lu.solve(np.ascontiguousarray(x.T), trans="T").T
-        return np.asarray(lam, dtype=float)
-
     def multipliers(self, lam: np.ndarray) -> dict[str, np.ndarray] | Multipliers:
         """The per-constraint multipliers (N) of stacked ones in the scheme's basis: a plain
         dict without rewritten rows, a lazy :class:`Multipliers` otherwise."""

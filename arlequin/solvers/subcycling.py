@@ -274,9 +274,8 @@ class SubcycledCentralDifference(CentralDifference):
         self._plan_h = self.dt
         self._big_prev = 0.0
         self._big_cur = 0.0
-        # the internal force of the last macro time (N) and M⁻¹ f_slow (m/s²) on the slow dofs
-        # in the order of _slow_ranges, made from it when a kick needs it (None until then)
-        self._slow_force = np.zeros(self.ops.n)
+        # M⁻¹ f_slow (m/s²) on the slow dofs in the order of _slow_ranges, made from the macro
+        # time's internal force (_f_int at the start of a macro step) when a kick needs it
         self._minv_f_slow: np.ndarray | None = None
         self._starting = True  # the forces at t0 are those of a macro time
         super()._initialize()
@@ -287,8 +286,7 @@ class SubcycledCentralDifference(CentralDifference):
 
     def _scheme_fields(self) -> tuple[str, ...]:
         return (*super()._scheme_fields(), "_j", "_m_n", "_plan_h", "_big_prev", "_big_cur",
-                "_slow_force", "_minv_f_slow", "macro_steps", "ratios",
-                "_energy_scale")  # fmt: skip
+                "_minv_f_slow", "macro_steps", "ratios", "_energy_scale")  # fmt: skip
 
     def _kinetic(self) -> np.ndarray:
         """½ ṽ⁻·M v⁺ per block; at a macro time the slow dofs' ṽ⁻ uses the macro steps."""
@@ -328,10 +326,8 @@ class SubcycledCentralDifference(CentralDifference):
         in ``_minv_f_slow``; the returned internal force is zero on the slow dofs otherwise)."""
         macro_time = self._starting or self._j + 1 == self._m_n
         if macro_time:
-            f_int, f_ext, trial = super()._forces(u, t, dt)
-            self._slow_force = f_int  # never modified in place (read by the kick and the works)
-            self._minv_f_slow = None
-            return f_int, f_ext, trial
+            self._minv_f_slow = None  # of the force made here, which becomes _f_int
+            return super()._forces(u, t, dt)
         return super()._forces(u, t, dt, blocks=self._fast_b)
 
     def _kick(self, v_minus: np.ndarray, dt_bar: float) -> np.ndarray:
@@ -342,8 +338,8 @@ class SubcycledCentralDifference(CentralDifference):
             big_bar = 0.5 * (self._big_prev + self._m_n * self.dt)
             scale = big_bar - dt_bar
             if scale != 0.0:  # zero while the macro steps are single fine steps (m = 1)
-                if self._minv_f_slow is None:
-                    minv, f = self.ops.inv_mass, self._slow_force
+                if self._minv_f_slow is None:  # _f_int is the macro time's force (j = 0)
+                    minv, f = self.ops.inv_mass, self._f_int
                     parts = [minv[sl] * f[sl] for sl in self._slow_ranges]
                     self._minv_f_slow = parts[0] if len(parts) == 1 else np.concatenate(parts)
                 start = 0
