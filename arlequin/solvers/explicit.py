@@ -123,7 +123,7 @@ class CentralDifference(Integrator):
         self.check_dt = bool(check_dt)
         self.stable_step: StableStep | None = None
         self._solver: ImpulseSolver | None = None
-        self._model_steps0: dict[tuple[int, int], float] = {}
+        self._critical_found: list[tuple[Any, int, Any, float]] | None = None
         self._critical_now: float | None = None
         self._critical_at: int | None = None
         self._impulse_failed = False
@@ -187,22 +187,29 @@ class CentralDifference(Integrator):
             return crit
         self._critical_at = self.step_count
         ratio = 1.0
-        for bi, b in enumerate(self.ops.blocks):
-            if self.ops.block_linear[bi]:
-                continue
-            for ti, term in enumerate(b.terms):
-                if "critical_time_step" not in capabilities(term.model):
-                    continue
-                key = (bi, ti)
-                ut = self.ops._term_u(b, term, u)
-                if key not in self._model_steps0:
-                    self._model_steps0[key] = float(
-                        term.model.critical_time_step(np.zeros_like(ut), None)
-                    )
-                now = float(term.model.critical_time_step(ut, self.states[b.name][ti]))
-                ratio = min(ratio, now / self._model_steps0[key])
+        for b, ti, term, step0 in self._critical_terms():
+            now = float(term.model.critical_time_step(self.ops._term_u(b, term, u),
+                                                      self.states[b.name][ti]))  # fmt: skip
+            ratio = min(ratio, now / step0)
         self._critical_now = crit * ratio
         return self._critical_now
+
+    def _critical_terms(self) -> list[tuple[Any, int, Any, float]]:
+        """(block, term index, term, its critical step at u = 0 (s)) of the nonlinear models
+        with the ``"critical_time_step"`` capability, found once: the capability test (protocol
+        checks, ~12 µs a model) is not repeated at every estimate."""
+        if self._critical_found is None:
+            found = []
+            for bi, b in enumerate(self.ops.blocks):
+                if self.ops.block_linear[bi]:
+                    continue
+                for ti, term in enumerate(b.terms):
+                    if "critical_time_step" not in capabilities(term.model):
+                        continue
+                    u0 = self.ops._term_u(b, term, np.zeros(self.u.shape))
+                    found.append((b, ti, term, float(term.model.critical_time_step(u0, None))))
+            self._critical_found = found
+        return self._critical_found
 
     def _default_controller(self) -> StepController:
         return FixedStep(self.safety * self._stable().critical)
