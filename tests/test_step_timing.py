@@ -10,7 +10,14 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from arlequin.solvers.rows import transposed, transposed_times
+from arlequin.contract import ConstraintError
+from arlequin.solvers.impulses import ImpulseSolver
+from arlequin.solvers.rows import (
+    rows_times,
+    subtract_transposed,
+    transposed,
+    transposed_times,
+)
 from arlequin.solvers.timing import SWITCH, StepTimer
 
 
@@ -35,6 +42,52 @@ def test_transposed_times_is_the_transposed_product_bit_for_bit(duplicates):
         g = _random_rows(rng, m, n, duplicates)
         lam = rng.standard_normal(m) * 1e4
         assert np.array_equal(transposed_times(g, lam), transposed(g) @ lam)
+
+
+@pytest.mark.parametrize("duplicates", [False, True])
+def test_compiled_row_products_are_the_numpy_ones_bit_for_bit(duplicates):
+    # references: scipy's CSR product, and the bincount path that subtract_transposed replaces
+    # in the explicit step (v -= M⁻¹ Gᵀλ)
+    rng = np.random.default_rng(31)
+    for _ in range(100):
+        m, n = int(rng.integers(1, 30)), int(rng.integers(1, 200))
+        g = _random_rows(rng, m, n, duplicates)
+        x = rng.standard_normal(n)
+        assert np.array_equal(rows_times(g, x), g @ x)
+        lam = rng.standard_normal(m) * 1e4
+        minv = rng.uniform(0.5, 2.0, n) * 10.0 ** rng.integers(-3, 4, n)
+        v = rng.standard_normal(n)
+        v[: n // 3] = 0.0
+        expected = v.copy()
+        push = transposed_times(g, lam)
+        push *= minv
+        expected -= push
+        scratch = np.zeros(n)
+        subtract_transposed(g, lam, minv, v, scratch)
+        assert np.array_equal(v, expected)
+        assert not scratch.any()  # left zeros for the next call
+
+
+def test_dense_active_rows_factor_refuses_dependent_rows():
+    # two copies of one contact row (no equality rows): S_AA is singular to round-off; the
+    # dense Cholesky must report it as the sparse factorisation did, not return huge impulses
+    class _NoRows:
+        m = 0
+
+    solver = ImpulseSolver(_NoRows(), np.full(6, 2.0))
+    row = np.array([0.0, 1.0, 0.0, 0.3, 0.0, 0.0])
+    g = sp.csr_matrix(np.vstack([row, row]))
+    with pytest.raises(ConstraintError, match="dependent"):
+        solver.solve(np.zeros(0), g, np.ones(2))
+    # dependent to 1e-8 of the entries: a positive pivot of ~1e-16 of its row's diagonal
+    g = sp.csr_matrix(np.vstack([row, row + [0.0, 0.0, 0.0, 0.0, 0.0, 1e-8]]))
+    with pytest.raises(ConstraintError, match="dependent"):
+        solver.solve(np.zeros(0), g, np.ones(2))
+    # independent rows: the impulses solve G M⁻¹ Gᵀ Λ = r
+    g = sp.csr_matrix(np.vstack([row, [1.0, 0.0, 0.0, 0.0, 0.0, 2.0]]))
+    _, lam = solver.solve(np.zeros(0), g, np.array([1.0, -2.0]))
+    s = (g @ sp.diags(np.full(6, 2.0)) @ g.T).toarray()
+    np.testing.assert_allclose(s @ lam, [1.0, -2.0], rtol=1e-14)
 
 
 def test_timer_is_off_by_default_and_restored_after_its_context():

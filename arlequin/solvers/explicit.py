@@ -50,7 +50,7 @@ from .damping import RayleighDamping
 from .impulses import ImpulseSolver
 from .registry import register
 from .row_basis import ImpulseBasis
-from .rows import EqualityRows, transposed_times, unilateral_block_powers
+from .rows import EqualityRows, rows_times, subtract_transposed, unilateral_block_powers
 from .stability import DEFAULT_SAFETY, StableStep, check_time_step, stable_time_step
 from .timing import SWITCH
 
@@ -124,6 +124,7 @@ class CentralDifference(Integrator):
         self.stable_step: StableStep | None = None
         self._solver: ImpulseSolver | None = None
         self._critical_found: list[tuple[Any, int, Any, float]] | None = None
+        self._columns_scratch: np.ndarray | None = None  # zeros (n,): subtract_transposed's
         self._critical_now: float | None = None
         self._critical_at: int | None = None
         self._impulse_failed = False
@@ -294,15 +295,17 @@ class CentralDifference(Integrator):
             # velocity-level rows (contact) target rhs_a itself: no product with u for them
             tic = timer.clock() if timer is not None else 0.0
             w_a = np.where(disp, (rhs_a - g_a @ u) / dt, rhs_a) if disp.any() else rhs_a
-            r_a = g_a @ v_star - w_a
+            r_a = rows_times(g_a, v_star) - w_a
             lam_e, lam_a = solver.solve(r_e, g_a, r_a)
             v_new = v_star.copy()
             if rows.m:
                 v_new[rows.cols] -= self._minv_cols * rows.transpose_times(lam_e)
             if g_a.shape[0]:
-                push = transposed_times(g_a, lam_a)
-                push *= minv  # M⁻¹ Gᵀλ in Gᵀλ's own new array (commutative: the same bits)
-                v_new -= push
+                # M⁻¹ Gᵀλ subtracted on G_A's columns alone (no n-vector for a few rows)
+                scratch = self._columns_scratch
+                if scratch is None or scratch.shape != minv.shape:
+                    scratch = self._columns_scratch = np.zeros(minv.shape)
+                subtract_transposed(g_a, lam_a, minv, v_new, scratch)
             if timer is not None:
                 timer.linear_algebra += timer.clock() - tic
             fulls = self._full_multipliers(lam_a / dt_bar, idx)

@@ -19,7 +19,7 @@ import scipy.sparse as sp
 from ..contract import csr_pattern, csr_with_data, same_pattern
 from ..problem.system import LinearConstraint
 from .block_sums import signed_block_sums, touched_index
-from .csr import CsrProduct
+from .csr import CsrProduct, csr_times, subtract_scaled_transposed
 from .linalg import factor_checked
 from .operators import SystemOperators
 
@@ -29,8 +29,10 @@ __all__ = [
     "EqualityRows",
     "consistent_initial_state",
     "rows_key",
+    "rows_times",
     "scatter_active",
     "stack_active",
+    "subtract_transposed",
     "transposed",
     "transposed_times",
     "unilateral_block_power",
@@ -192,6 +194,41 @@ def transposed_times(g: sp.csr_matrix, lam: np.ndarray) -> np.ndarray:
     """
     weights = g.data * np.repeat(lam, np.diff(g.indptr))
     return np.bincount(g.indices, weights, minlength=g.shape[1])
+
+
+def _compiled_rows(g: sp.csr_matrix, *vectors: np.ndarray) -> bool:
+    """Whether the compiled row kernels take G and these vectors as they are (float64 values,
+    contiguous float64 vectors of G's sizes)."""
+    return g.data.dtype == np.float64 and all(
+        x.dtype == np.float64 and x.ndim == 1 and x.flags.c_contiguous for x in vectors
+    )
+
+
+def rows_times(g: sp.csr_matrix, x: np.ndarray) -> np.ndarray:
+    """``G x`` (m,) of CSR rows G (m, n): scipy's product bit for bit
+    (:func:`~arlequin.solvers.csr.csr_times`), without its Python-level checks (a few µs, each
+    status iteration of a contact step)."""
+    if not (_compiled_rows(g, x) and x.shape == (g.shape[1],)):
+        return g @ x
+    y = np.empty(g.shape[0])
+    csr_times(g.indptr, g.indices, g.data, x, y)
+    return y
+
+
+def subtract_transposed(g: sp.csr_matrix, lam: np.ndarray, scale: np.ndarray, v: np.ndarray,
+                        scratch: np.ndarray) -> None:  # fmt: skip
+    """``v −= scale ⊙ (Gᵀ λ)`` in place for CSR rows G (m, n), multipliers λ (m,) and a scale
+    (n,) (M⁻¹): the bits of ``v -= scale * transposed_times(g, lam)`` on G's columns alone
+    (:func:`~arlequin.solvers.csr.subtract_scaled_transposed`); ``scratch`` (n,) zeros, left
+    zeros."""
+    n = g.shape[1]
+    sizes = lam.shape == (g.shape[0],) and v.shape == scale.shape == scratch.shape == (n,)
+    if not (sizes and _compiled_rows(g, lam, scale, v, scratch)):
+        push = transposed_times(g, lam)
+        push *= scale
+        v -= push
+        return
+    subtract_scaled_transposed(g.indptr, g.indices, g.data, lam, scale, v, scratch)
 
 
 def unilateral_block_power(
