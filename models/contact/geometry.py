@@ -22,8 +22,8 @@ from skfem import Mesh
 from arlequin.contract import csr_pattern, csr_with_data, node_dofs
 from arlequin.geometry.facets import cyclic_quad_faces, facet_normals
 
-from .kernel import project_segments
-from .obstacles import Obstacle
+from .kernel import plane_gaps, project_segments
+from .obstacles import Obstacle, PlaneObstacle
 
 __all__ = [
     "ContactGeometry",
@@ -253,6 +253,17 @@ class RigidContactPair(ContactPair):
             n = self._normals(slave.positions(np.zeros(self.n_dofs)))
             n.flags.writeable = False
             self._fixed = (n, csr_with_data(self._template, (-n).T.ravel()))
+        # the plane's arrays in the compiled gaps' types (its exact class: a subclass may
+        # change phi)
+        self._plane: tuple[np.ndarray, ...] | None = None
+        if type(obstacle) is PlaneObstacle and self._fixed is not None:
+            c = np.ascontiguousarray
+            self._plane = (
+                c(slave._x_ref, dtype=float),
+                c(slave._dofs, dtype=np.int64),
+                c(obstacle.normal, dtype=float),
+                c(obstacle.point, dtype=float),
+            )
 
     def _normals(self, x: np.ndarray) -> np.ndarray:
         """Unit normals ∇φ/|∇φ| at the points x (dim, m)."""
@@ -263,6 +274,12 @@ class RigidContactPair(ContactPair):
         return g / gn
 
     def geometry(self, u: np.ndarray) -> ContactGeometry:
+        if self._plane is not None and u.dtype == np.float64 and u.shape == (self.n_dofs,):
+            # a plane: the gaps in one compiled pass (the numpy lines below, their reference)
+            x_ref, dofs, normal, point = self._plane
+            n, rows = self._fixed
+            return ContactGeometry(rows, plane_gaps(x_ref, dofs, u, normal, point), n,
+                                   self._jump)  # fmt: skip
         x = self.slave.positions(u)
         phi = self.obstacle.phi(x)
         if self._fixed is not None:

@@ -26,6 +26,7 @@ __all__ = [
     "equal_at",
     "level_set_begin",
     "level_set_status",
+    "plane_gaps",
     "project_segments",
     "rows_times",
     "rows_times_sum",
@@ -69,6 +70,25 @@ def project_segments(xs: np.ndarray, a: np.ndarray, b: np.ndarray, orient: np.nd
         xm[0, i] = a[0, f] * s0 + b[0, f] * s1
         xm[1, i] = a[1, f] * s0 + b[1, f] * s1
     return k, tk, nrm, xm
+
+
+@njit(cache=True)
+def plane_gaps(x_ref: np.ndarray, dofs: np.ndarray, u: np.ndarray, normal: np.ndarray,
+               point: np.ndarray) -> np.ndarray:  # fmt: skip
+    """Gaps ``−n·(X + u[dofs] − p)`` (m,) (m) of points at reference positions ``x_ref``
+    (dim, m) with dofs ``dofs`` (dim, m) in u (n,), against the plane through ``point`` (dim,)
+    of unit normal ``normal`` (dim,): :meth:`PlaneObstacle.phi
+    <arlequin.models.contact.obstacles.PlaneObstacle.phi>` of the positions, negated, in one
+    pass (three numpy calls and a BLAS product, ~20 µs of a Taylor bar step in the run, before).
+    The sum over the dim components runs in order; BLAS's may not: equal to round-off."""
+    d, m = x_ref.shape
+    gap = np.empty(m)
+    for i in range(m):
+        s = 0.0
+        for k in range(d):
+            s += normal[k] * ((x_ref[k, i] + u[dofs[k, i]]) - point[k])
+        gap[i] = -s
+    return gap
 
 
 @njit(cache=True)
