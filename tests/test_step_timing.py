@@ -80,9 +80,17 @@ def test_dense_active_rows_factor_refuses_dependent_rows():
     with pytest.raises(ConstraintError, match="dependent"):
         solver.solve(np.zeros(0), g, np.ones(2))
     # dependent to 1e-8 of the entries: a positive pivot of ~1e-16 of its row's diagonal
-    g = sp.csr_matrix(np.vstack([row, row + [0.0, 0.0, 0.0, 0.0, 0.0, 1e-8]]))
+    g = sp.csr_matrix(np.vstack([row, row + np.array([0.0, 0.0, 0.0, 0.0, 0.0, 1e-8])]))
     with pytest.raises(ConstraintError, match="dependent"):
         solver.solve(np.zeros(0), g, np.ones(2))
+    # an active row without entries (on a wall: the diagonal path)
+    g = sp.csr_matrix(np.vstack([row, np.zeros(6)]))
+    with pytest.raises(ConstraintError, match="empty row 1"):
+        solver.solve(np.zeros(0), g, np.ones(2))
+    # rows on distinct dofs: diagonal, x = (1 / d) r as the sparse factorisation's diagonal path
+    g = sp.csr_matrix(np.array([[0.0, 2.0, 0.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0, -3.0, 0.0, 0.0]]))
+    _, lam = solver.solve(np.zeros(0), g, np.array([1.0, -2.0]))
+    assert np.array_equal(lam, (1.0 / np.array([8.0, 18.0])) * np.array([1.0, -2.0]))
     # independent rows: the impulses solve G M⁻¹ Gᵀ Λ = r
     g = sp.csr_matrix(np.vstack([row, [1.0, 0.0, 0.0, 0.0, 0.0, 2.0]]))
     _, lam = solver.solve(np.zeros(0), g, np.array([1.0, -2.0]))

@@ -378,7 +378,8 @@ class CentralDifference(Integrator):
         # modified in place; a restored run recomputes them, to the same numbers)
         p_now, p_next = self._powers(v_minus, v_next)
         self._p_next = (v_next, p_next)
-        self._w_pending = tuple(half * (p + q) for p, q in zip(self._p_prev, p_now))
+        # (4, n_blocks): external, coupling, other constraints, damping
+        self._w_pending = half * (self._p_prev + p_now)
 
     def _kick(self, v_minus: np.ndarray, dt_bar: float) -> np.ndarray:
         """The free prediction v* = v^{n−½} + Δt̄_n a^n (a new array)."""
@@ -392,31 +393,30 @@ class CentralDifference(Integrator):
         back = self._v_next - (self.dt / self._dt_bar) * (self._v_next - self._v_minus)
         return 0.5 * self.ops.block_dots(back, self.ops.mass * self._v_next)
 
-    def _powers(self, v: np.ndarray, v2: np.ndarray | None = None):
+    def _powers(self, v: np.ndarray, v2: np.ndarray | None = None) -> np.ndarray:
         """External, coupling, other-constraint and damping powers per block (W) of the forces
-        at the current time with the velocity v (m/s): a tuple of four (n_blocks,) arrays; with
-        a second velocity v2, the pair of those tuples (the constraint forces computed once)."""
+        at the current time with the velocity v (m/s): an array (4, n_blocks), rows in that
+        order; with a second velocity v2, an array (2, 4, n_blocks), one such array for each
+        velocity (the constraint forces computed once)."""
         vs = (v,) if v2 is None else (v, v2)
         nb = len(self.ops.blocks)
+        out = np.zeros((len(vs), 4, nb))
         if self.rows.m:
-            eq = self.rows.block_powers_of(self._lam_e / self._dt_bar, vs)
-        else:
-            eq = [(np.zeros(nb), np.zeros(nb)) for _ in vs]
-        uni = unilateral_block_powers(self.ops, self._g_a, self._lam_a / self._dt_bar, vs) \
-            if self._g_a.shape[0] else None  # fmt: skip
-        out = []
+            for i, (pc, po) in enumerate(self.rows.block_powers_of(self._lam_e / self._dt_bar, vs)):
+                out[i, 1] = pc
+                out[i, 2] = po
+        if self._g_a.shape[0]:
+            lam = self._lam_a / self._dt_bar
+            for i, p in enumerate(unilateral_block_powers(self.ops, self._g_a, lam, vs)):
+                out[i, 2] += p
         for i, x in enumerate(vs):
-            pc, po = eq[i]
-            if uni is not None:
-                po = po + uni[i]
-            p_ext = self.ops.block_dots(self._f_ext, x) if self._f_ext is not None else \
-                np.zeros(nb)  # fmt: skip
+            if self._f_ext is not None:
+                out[i, 0] = self.ops.block_dots(self._f_ext, x)
             if self._f_applied is not None:  # slip friction
-                po = po + self.ops.block_dots(self._f_applied, x)
-            p_damp = np.zeros(nb) if self._f_damp is None else \
-                -self.ops.block_dots(self._f_damp, x)  # fmt: skip
-            out.append((p_ext, pc, po, p_damp))
-        return out[0] if v2 is None else (out[0], out[1])
+                out[i, 2] += self.ops.block_dots(self._f_applied, x)
+            if self._f_damp is not None:
+                out[i, 3] = -self.ops.block_dots(self._f_damp, x)
+        return out[0] if v2 is None else out
 
     def _damping_force(self, v: np.ndarray) -> np.ndarray | None:
         """C v (N) with the mid-step velocity v that precedes the force's time, or None."""
@@ -461,7 +461,7 @@ class CentralDifference(Integrator):
         self._dt_prev = 0.0
         self._pre_impulse_states = self.constraint_states
         nb = len(self.ops.blocks)
-        self._p_prev = (np.zeros(nb), np.zeros(nb), np.zeros(nb), np.zeros(nb))
+        self._p_prev = np.zeros((4, nb))
         self._impulse_at_t()
 
     def _step_size_changed(self) -> None:

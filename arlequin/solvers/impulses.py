@@ -116,8 +116,11 @@ class ImpulseSolver:
                 if m_a <= self._DENSE_SCHUR:
                     # dense: a chattering contact changes its rows every few steps, and a
                     # sparse factorisation cost 330 µs against ~15 µs (Taylor bar, 8 rows)
-                    return _DenseFactor(self._cholesky(
-                        _dense_gram(g_a, minv, self._pattern_of(g_a)), m_a))  # fmt: skip
+                    gram = _dense_gram(g_a, minv, self._pattern_of(g_a))
+                    diag = np.diagonal(gram)
+                    if np.count_nonzero(gram) == np.count_nonzero(diag):
+                        return _DiagonalFactor(diag, m_a)  # independent rows (a wall)
+                    return _DenseFactor(self._cholesky(gram, m_a))
                 s_aa = (ga_m() @ g_a.T).tocsr()
                 return factor_checked(s_aa, "the impulse matrix of the active rows", spd=True)
 
@@ -262,6 +265,26 @@ class _DenseFactor:
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
         return dense_cho_solve(self.cho, rhs)
+
+
+class _DiagonalFactor:
+    """Independent rows: x = r / diag by the products of :class:`ScaledLU`'s diagonal path
+    (``(1 / d) * r``, the same bits), with its test of an empty row."""
+
+    __slots__ = ("inv",)
+
+    def __init__(self, diag: np.ndarray, m_a: int) -> None:
+        scale = np.max(np.abs(diag))
+        small = np.nonzero(~(np.abs(diag) > 1e-14 * scale))[0]
+        if small.size:
+            raise ConstraintError(
+                f"the impulse matrix of the active rows has an empty row {int(small[0])} "
+                f"({m_a} active rows)"
+            )
+        self.inv = 1.0 / diag
+
+    def solve(self, rhs: np.ndarray) -> np.ndarray:
+        return self.inv * rhs
 
 
 def _dense_gram(g: sp.csr_matrix, minv: np.ndarray, pattern: dict) -> np.ndarray:
