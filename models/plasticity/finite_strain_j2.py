@@ -146,6 +146,7 @@ class FiniteStrainJ2(CellStates):
         self._h0 = np.sqrt(area) if dim == 2 else np.cbrt(area)
         self._critical_ratio: np.ndarray | None = None
         self._size_arrays: tuple | None = None  # the compiled critical step's mesh arrays
+        self._wave_speed: tuple | None = None  # (the material, its c_d (m/s)) of the last estimate
         self._kernel_static: tuple | None = None  # contiguous inputs and scratch of the kernel
         self._ones: np.ndarray | None = None
         self._alpha_of: tuple | None = None  # (read-only weight, its checked broadcast)
@@ -576,7 +577,11 @@ class FiniteStrainJ2(CellStates):
         calibrated once per cell so that at u = 0 it is the element eigenvalue bound of
         :func:`~arlequin.models.elastic.element_critical_step` (a lower bound of the critical
         step): cheap enough to follow crushed cells. Capability ``"critical_time_step"``."""
-        cd = self.material.dilatational_wave_speed
+        # c_d of the material, kept (its moduli from E and ν: 8 µs a call, every estimate)
+        kept = self._wave_speed
+        if kept is None or kept[0] is not self.material:
+            kept = self._wave_speed = (self.material, self.material.dilatational_wave_speed)
+        cd = kept[1]
         if self._critical_ratio is None:
             per_cell = element_critical_step(self.elastic, self.elastic.basis, per_cell=True)
             self._critical_ratio = per_cell * cd / self.kin.cell_sizes(self.mesh.p)

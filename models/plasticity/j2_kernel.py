@@ -113,7 +113,7 @@ def assembly_dofs(cell_dofs: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(np.transpose(cell_dofs, (2, 1, 0)), dtype=dtype)
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, error_model="numpy")
 def min_scaled_cell_size(p, cells, dofs, u, ratio):
     """min over the Q1 cells of ``ratio[e] · h_e`` (m), h_e the cell's area over its longest edge
     in the configuration x = p + u[dofs]: the numbers of
@@ -143,7 +143,7 @@ def min_scaled_cell_size(p, cells, dofs, u, ratio):
             x[1, k] = p[1, n] + u[dofs[1, n]]
         longest2 = -np.inf
         for k in range(4):
-            k1 = (k + 1) % 4
+            k1 = k + 1 if k < 3 else 0  # (k + 1) % 4 without Python's signed modulo
             d0 = x[0, k1] - x[0, k]
             d1 = x[1, k1] - x[1, k]
             s = d0 * d0 + d1 * d1
