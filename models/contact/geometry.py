@@ -22,7 +22,7 @@ from skfem import Mesh
 from arlequin.contract import csr_pattern, csr_with_data, node_dofs
 from arlequin.geometry.facets import cyclic_quad_faces, facet_normals
 
-from .kernel import plane_gaps, project_segments
+from .kernel import plane_gaps, project_segments, segment_geometry
 from .obstacles import Obstacle, PlaneObstacle
 
 __all__ = [
@@ -342,6 +342,15 @@ class DeformableContactPair(ContactPair):
         self._pattern: tuple | None = None  # the rows' pattern for the last facets (geometry)
         self._vals: np.ndarray | None = None  # the rows' values by point (m, w), a buffer
         self._orient_f = np.ascontiguousarray(self._orient, dtype=float)
+        # 2D segments: the compiled geometry's arrays (segment_geometry)
+        self._segments: tuple[np.ndarray, ...] | None = None
+        if self.compiled and master.dim == 2 and nv == 2:
+            self._segments = (
+                np.ascontiguousarray(slave._x_ref, dtype=float),
+                np.ascontiguousarray(slave._dofs, dtype=np.int64),
+                np.ascontiguousarray(self._tri_p, dtype=float),
+                np.ascontiguousarray(self._tri_dofs, dtype=np.int64),
+            )
         self.geometry_dofs = np.unique(np.concatenate([self._c_s, self._tri_dofs.ravel()]))
 
     def _project(self, xs: np.ndarray, u: np.ndarray):
@@ -381,26 +390,48 @@ class DeformableContactPair(ContactPair):
         xm = np.einsum("dkv,kv->dk", xf[:, k], shape)
         return k, shape, xm, nrm
 
-    def geometry(self, u: np.ndarray) -> ContactGeometry:
-        s = self.slave
-        xs = s.positions(u)
-        k, shape, xm, n = self._project(xs, u)
-        gap = -np.sum(n * (xs - xm), axis=0)
-        m, d = s.n_points, s.dim
-        nv = shape.shape[1]
-        # slave part: −n·v_s; master part: +N_j n·v_j
-        v_s = (-n).T  # (m, d)
-        v_m = shape[:, :, None] * n.T[:, None, :]
+    def _pattern_for(self, k: np.ndarray, nv: int) -> tuple:
+        """(facets, COO indices, :func:`_row_pattern`) of the rows when the points project on
+        the facets k (m,): the rows' columns depend on those alone (the same from one step to
+        the next, mostly), so their order and arrays are made once for them."""
         pattern = self._pattern
         if pattern is None or not np.array_equal(pattern[0], k):
-            # the rows' columns depend on the facets the points project on alone (the same
-            # from one step to the next, mostly): their order and arrays made once for them
+            m, d = self.slave.n_points, self.slave.dim
             c_m = self._tri_dofs_by_point[k]  # (m, nv, d)
             ij = (np.concatenate([self._r_s, self._r_m]),
                   np.concatenate([self._c_s, c_m.ravel()]))  # fmt: skip
             cols = np.hstack([self._c_s.reshape(m, d), c_m.reshape(m, nv * d)])
             pattern = (k.copy(), ij, _row_pattern(cols, self.n_dofs))
             self._pattern = pattern
+        return pattern
+
+    def geometry(self, u: np.ndarray) -> ContactGeometry:
+        s = self.slave
+        m, d = s.n_points, s.dim
+        if self._segments is not None and u.dtype == np.float64 and u.shape == (self.n_dofs,):
+            # 2D segments: everything up to the rows' values in one compiled call (the numpy
+            # lines below are its reference, the same numbers bit for bit)
+            x_ref, s_dofs, seg_ref, seg_dofs = self._segments
+            vals = self._vals
+            if vals is None or vals.shape != (m, 6):
+                vals = self._vals = np.empty((m, 6))
+            k, shape, n, gap = segment_geometry(x_ref, s_dofs, seg_ref, seg_dofs, u,
+                                                self._orient_f, vals)  # fmt: skip
+            _, ij, by_point = self._pattern_for(k, 2)
+            if by_point is not None:
+                flat, template = by_point
+                rows = csr_with_data(template, vals.ravel()[flat])
+                return ContactGeometry(rows, gap, n, _JumpRows(ij, (m, self.n_dofs), shape))
+            v_s, v_m = vals[:, :2], vals[:, 2:].reshape(m, 2, 2)
+        else:
+            xs = s.positions(u)
+            k, shape, xm, n = self._project(xs, u)
+            gap = -np.sum(n * (xs - xm), axis=0)
+            # slave part: −n·v_s; master part: +N_j n·v_j
+            v_s = (-n).T  # (m, d)
+            v_m = shape[:, :, None] * n.T[:, None, :]
+        nv = shape.shape[1]
+        pattern = self._pattern_for(k, nv)
         _, ij, by_point = pattern
         if by_point is None:  # a dof twice in a row (a surface against itself): summed by COO
             vals = np.concatenate([v_s.ravel(), v_m.ravel()])

@@ -31,6 +31,7 @@ __all__ = [
     "rows_times",
     "rows_times_sum",
     "scaled_entries",
+    "segment_geometry",
 ]
 
 
@@ -89,6 +90,70 @@ def plane_gaps(x_ref: np.ndarray, dofs: np.ndarray, u: np.ndarray, normal: np.nd
             s += normal[k] * ((x_ref[k, i] + u[dofs[k, i]]) - point[k])
         gap[i] = -s
     return gap
+
+
+@njit(cache=True)
+def segment_geometry(x_ref: np.ndarray, s_dofs: np.ndarray, seg_ref: np.ndarray,
+                     seg_dofs: np.ndarray, u: np.ndarray, orient: np.ndarray,
+                     vals: np.ndarray):  # fmt: skip
+    """The geometry of 2D point-to-segment contact at displacement u, in one call.
+
+    The numbers of :meth:`DeformableContactPair.geometry
+    <arlequin.models.contact.geometry.DeformableContactPair.geometry>`'s numpy lines bit for
+    bit (the same operations on the same values): slave positions ``xs = x_ref + u[s_dofs]``,
+    segment ends ``seg_ref + u[seg_dofs]``, the projection (:func:`project_segments`), the gaps
+    ``−n·(xs − x_m)`` and the rows' values by point. About fifteen numpy calls a step before
+    (24 µs warm of a ball impact step, three times that in the run).
+
+    Parameters
+    ----------
+    x_ref, s_dofs : ndarray, shape (2, m)
+        Slave points' reference positions (m) and dofs in u.
+    seg_ref : ndarray, shape (2, n_f, 2)
+        Segment ends' reference positions (m): component, segment, end.
+    seg_dofs : ndarray, shape (2, n_f · 2)
+        Their dofs in u (segment-major, then end).
+    u : ndarray, shape (n,)
+    orient : ndarray, shape (n_f,)
+        ±1 per segment (outward normals).
+    vals : ndarray, shape (m, 6)
+        Output: the rows' values by point, ``−n`` then ``N_j n`` for the two ends j.
+
+    Returns
+    -------
+    k : ndarray of int64, shape (m,)
+        Closest segment.
+    shape : ndarray, shape (m, 2)
+        Its shape values (1 − t, t) at the projection.
+    normal : ndarray, shape (2, m)
+    gap : ndarray, shape (m,)
+        d_n (m).
+    """
+    m = x_ref.shape[1]
+    nf = seg_ref.shape[1]
+    xs = np.empty((2, m))
+    for c in range(2):
+        for i in range(m):
+            xs[c, i] = x_ref[c, i] + u[s_dofs[c, i]]
+    a = np.empty((2, nf))
+    b = np.empty((2, nf))
+    for c in range(2):
+        for f in range(nf):
+            a[c, f] = seg_ref[c, f, 0] + u[seg_dofs[c, 2 * f]]
+            b[c, f] = seg_ref[c, f, 1] + u[seg_dofs[c, 2 * f + 1]]
+    k, tk, nrm, xm = project_segments(xs, a, b, orient)
+    shape = np.empty((m, 2))
+    gap = np.empty(m)
+    for i in range(m):
+        shape[i, 0] = 1.0 - tk[i]
+        shape[i, 1] = tk[i]
+        gap[i] = -(nrm[0, i] * (xs[0, i] - xm[0, i]) + nrm[1, i] * (xs[1, i] - xm[1, i]))
+        vals[i, 0] = -nrm[0, i]
+        vals[i, 1] = -nrm[1, i]
+        for j in range(2):
+            for c in range(2):
+                vals[i, 2 + 2 * j + c] = shape[i, j] * nrm[c, i]
+    return k, shape, nrm, gap
 
 
 @njit(cache=True)
