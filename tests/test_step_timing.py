@@ -19,6 +19,7 @@ from arlequin.solvers.rows import (
     transposed_times,
 )
 from arlequin.solvers.timing import SWITCH, StepTimer
+from arlequin.solvers.vector_updates import interpolated, scaled_plus, work_products
 
 
 def _random_rows(rng, m: int, n: int, duplicates: bool) -> sp.csr_matrix:
@@ -96,6 +97,28 @@ def test_dense_active_rows_factor_refuses_dependent_rows():
     _, lam = solver.solve(np.zeros(0), g, np.array([1.0, -2.0]))
     s = (g @ sp.diags(np.full(6, 2.0)) @ g.T).toarray()
     np.testing.assert_allclose(s @ lam, [1.0, -2.0], rtol=1e-14)
+
+
+def test_compiled_vector_updates_are_the_numpy_lines_bit_for_bit():
+    # references: the numpy lines each compiled pass replaced in the explicit step
+    rng = np.random.default_rng(32)
+    for n in (0, 1, 7, 1000):
+        x, y, z, w = (rng.standard_normal(n) * 10.0 ** rng.integers(-9, 9, n) for _ in range(4))
+        alpha, share = 3.7e-8, 0.4999
+        ref = alpha * x
+        ref += y
+        assert scaled_plus(alpha, x, y).tobytes() == ref.tobytes()
+        ref = y - x
+        ref *= share
+        ref += x
+        assert interpolated(x, y, share).tobytes() == ref.tobytes()
+        f = z + w
+        f *= 0.5
+        ref = (x - y) * f
+        assert work_products(x, y, z, w, np.empty(n)).tobytes() == ref.tobytes()
+    # other layouts take the numpy lines themselves
+    x = np.arange(10.0)[::2]
+    np.testing.assert_array_equal(scaled_plus(2.0, x, x), 3.0 * x)
 
 
 def test_timer_is_off_by_default_and_restored_after_its_context():

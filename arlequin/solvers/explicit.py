@@ -53,6 +53,7 @@ from .row_basis import ImpulseBasis
 from .rows import EqualityRows, rows_times, subtract_transposed, unilateral_block_powers
 from .stability import DEFAULT_SAFETY, StableStep, check_time_step, stable_time_step
 from .timing import SWITCH
+from .vector_updates import interpolated, scaled_plus, work_products
 
 __all__ = ["DEFAULT_SAFETY", "CentralDifference"]
 
@@ -130,7 +131,7 @@ class CentralDifference(Integrator):
         self._impulse_failed = False
         self._f_applied: np.ndarray | None = None
         self.constraint_time = 0.0
-        self._work_buffers: tuple[np.ndarray, np.ndarray] | None = None
+        self._work_buffer: np.ndarray | None = None  # the internal work's products
         self._neg_inv_mass: tuple[np.ndarray, np.ndarray] | None = None
         super().__init__(system, dt, **kwargs)
 
@@ -312,8 +313,7 @@ class CentralDifference(Integrator):
             if f_app is not None:
                 fulls = [f if a is None else f + a for f, a in zip(fulls, applied)]
             self._f_applied = f_app
-            u_end = dt * v_new
-            u_end += u  # u + Δt v in one new array (commutative: the same bits)
+            u_end = scaled_plus(dt, v_new, u)  # u + Δt v, one compiled pass
             trials, changed = self._update_statuses(trials, u_end, v_new, fulls)
             if not changed:
                 converged = True
@@ -352,12 +352,8 @@ class CentralDifference(Integrator):
         self._v_next = v_next
         share = dt_prev / (dt_prev + dt)
         if share:
-            # v⁻ + share (v⁺ − v⁻) in one new array (the same operations, the last two in
-            # commuted order: the same bits)
-            v = v_next - v_minus
-            v *= share
-            v += v_minus
-            self.v = v
+            # v⁻ + share (v⁺ − v⁻) in one compiled pass
+            self.v = interpolated(v_minus, v_next, share)
         else:
             self.v = v_minus.copy()
         self._lam_e = lam_e
@@ -383,9 +379,7 @@ class CentralDifference(Integrator):
 
     def _kick(self, v_minus: np.ndarray, dt_bar: float) -> np.ndarray:
         """The free prediction v* = v^{n−½} + Δt̄_n a^n (a new array)."""
-        v_star = dt_bar * self.a
-        v_star += v_minus  # commutative: the bits of v⁻ + Δt̄ a, one array fewer
-        return v_star
+        return scaled_plus(dt_bar, self.a, v_minus)  # one compiled pass
 
     def _kinetic(self) -> np.ndarray:
         """The scheme's kinetic energy per block (J): ½ ṽ^{n−½}·M v^{n+½}, with ṽ^{n−½} the
@@ -490,8 +484,7 @@ class CentralDifference(Integrator):
         dt = self.dt
         t_new = self._end_time()
         v_half = self._v_next
-        u_new = dt * v_half
-        u_new += self.u  # u + Δt v^{n+½}, one new array (commutative: the same bits)
+        u_new = scaled_plus(dt, v_half, self.u)  # u + Δt v^{n+½}, one compiled pass
         f_int, f_ext, trial = self._forces(u_new, t_new, dt)
         f_damp = self._damping_force(v_half)  # −C v^{n+1/2}: the damping force at t_{n+1}
         a_new = self._acceleration(f_int if f_damp is None else f_int + f_damp, f_ext)
@@ -504,15 +497,12 @@ class CentralDifference(Integrator):
             self._powers(v_half)  # fmt: skip
         # commit the step's kinematics and model states
         if not self.ops.linear:
-            # Δu and the mean force in two kept buffers (read by block_dots only): the same
-            # numbers as u_new − u and 0.5 (f_old + f_new), without two new n-vectors a step
-            bufs = self._work_buffers
-            if bufs is None or bufs[0].shape != u_new.shape:
-                bufs = self._work_buffers = (np.empty_like(u_new), np.empty_like(u_new))
-            du = np.subtract(u_new, self.u, out=bufs[0])
-            f_mean = np.add(self._f_int, f_int, out=bufs[1])
-            f_mean *= 0.5
-            self._w_internal += self.ops.block_dots(du, f_mean)
+            # Δu ⊙ ½(f_old + f_new) in one compiled pass into a kept buffer, summed per block
+            buf = self._work_buffer
+            if buf is None or buf.shape != u_new.shape:
+                buf = self._work_buffer = np.empty(u_new.shape)
+            products = work_products(u_new, self.u, self._f_int, f_int, buf)
+            self._w_internal += self.ops.block_sums(products)
         self.u = u_new
         self.a = a_new
         self.states = trial

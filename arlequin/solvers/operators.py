@@ -305,6 +305,13 @@ class SystemOperators:
         return self.system.stiffness()
 
     # ------------------------------------------------------------------ per-block reductions
+    def block_sums(self, x: np.ndarray) -> np.ndarray:
+        """Per-block sums Σ_{j∈b} x_j, shape (n_blocks,) (numpy's segmented sums, those of
+        :meth:`block_dots` on its products)."""
+        if not self.n:
+            return np.zeros(len(self.blocks))
+        return np.add.reduceat(x, self.offsets[:-1])
+
     def block_dots(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
         """Per-block dot products Σ_{j∈b} x_j y_j, shape (n_blocks,)."""
         if not self.n:

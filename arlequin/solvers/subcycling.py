@@ -51,6 +51,7 @@ from .controllers import check_step
 from .explicit import CentralDifference
 from .registry import register
 from .stability import DEFAULT_SAFETY
+from .vector_updates import scaled_plus
 
 __all__ = ["SubcycledCentralDifference"]
 
@@ -331,8 +332,7 @@ class SubcycledCentralDifference(CentralDifference):
         return super()._forces(u, t, dt, blocks=self._fast_b)
 
     def _kick(self, v_minus: np.ndarray, dt_bar: float) -> np.ndarray:
-        v_star = dt_bar * self.a
-        v_star += v_minus  # commutative: the bits of v⁻ + Δt̄ a, one array fewer
+        v_star = scaled_plus(dt_bar, self.a, v_minus)  # v⁻ + Δt̄ a, one compiled pass
         if self._j == 0:
             # the slow internal force acts as one impulse H̄ f_slow instead of h̄ f_slow
             big_bar = 0.5 * (self._big_prev + self._m_n * self.dt)
