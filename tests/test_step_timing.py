@@ -19,7 +19,12 @@ from arlequin.solvers.rows import (
     transposed_times,
 )
 from arlequin.solvers.timing import SWITCH, StepTimer
-from arlequin.solvers.vector_updates import interpolated, scaled_plus, work_products
+from arlequin.solvers.vector_updates import (
+    interpolated,
+    scaled_plus,
+    sum_of_squares,
+    work_products,
+)
 
 
 def _random_rows(rng, m: int, n: int, duplicates: bool) -> sp.csr_matrix:
@@ -119,6 +124,20 @@ def test_compiled_vector_updates_are_the_numpy_lines_bit_for_bit():
     # other layouts take the numpy lines themselves
     x = np.arange(10.0)[::2]
     np.testing.assert_array_equal(scaled_plus(2.0, x, x), 3.0 * x)
+
+
+def test_sum_of_squares_of_the_finite_check():
+    # reference: the BLAS dot it replaced (another summation order: equal to round-off), and
+    # every non-finite case the check must see (NaN, ±inf, an overflow of the sum)
+    rng = np.random.default_rng(33)
+    x = rng.standard_normal(26_814)
+    assert sum_of_squares(x) == pytest.approx(float(x @ x), rel=1e-13)
+    for bad in (np.nan, np.inf, -np.inf):
+        y = x.copy()
+        y[12_345] = bad
+        assert not np.isfinite(sum_of_squares(y))
+    assert sum_of_squares(np.full(9, 1e200)) == np.inf  # each square 1e400: overflow
+    assert sum_of_squares(np.zeros(0)) == 0.0
 
 
 def test_timer_is_off_by_default_and_restored_after_its_context():

@@ -35,6 +35,7 @@ from .controllers import StepController, as_controller, check_step
 from .operators import SystemOperators, as_system, as_vector
 from .rows import EqualityRows, consistent_initial_state, scatter_active, stack_active
 from .timing import SWITCH
+from .vector_updates import sum_of_squares
 
 __all__ = ["STATUSES", "Integrator", "IntegratorSnapshot"]
 
@@ -45,13 +46,6 @@ STATUSES = ("running", "finished", "failed")
 
 #: Relative tolerance (of the step) within which a time counts as a stop time.
 _LANDING = 1e-9
-
-
-def _sum_of_squares(x: np.ndarray) -> float:
-    """Σ x_i² of a 1D float array by a BLAS dot product: 2 µs on 20,000 values against 10 µs
-    for ``np.einsum`` (twice an explicit step). The explicit schemes run with one BLAS thread
-    (``blas_threads``), so it wakes no pool beside the kernels there."""
-    return float(np.dot(x, x))
 
 
 @dataclass(frozen=True)
@@ -375,9 +369,8 @@ class Integrator:
         step = self.step_count + 1 if step is None else int(step)
         # Σx²: NaN, ±inf and values whose energy would overflow all make it non-finite
         check = 0.0
-        with np.errstate(over="ignore", invalid="ignore"):
-            for x in arrays:
-                check += _sum_of_squares(x)
+        for x in arrays:
+            check += sum_of_squares(x)
         if not math.isfinite(check):
             raise SimulationError(
                 f"{self.name}: non-finite displacement or velocity (NaN or overflow) at step "

@@ -17,7 +17,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-__all__ = ["interpolated", "scaled_plus", "work_products"]
+__all__ = ["interpolated", "scaled_plus", "sum_of_squares", "work_products"]
 
 
 @nb.njit(cache=True)
@@ -36,6 +36,16 @@ def _interpolated(x0, x1, share, out):
 def _work_products(u_new, u_old, f_old, f_new, out):
     for i in range(out.size):
         out[i] = (u_new[i] - u_old[i]) * ((f_old[i] + f_new[i]) * 0.5)
+
+
+# reassociation (the sum in SIMD lanes): the order does not matter to a finiteness test; no
+# "nnan"/"ninf" flags, which would let the compiler assume away what it tests
+@nb.njit(cache=True, fastmath={"reassoc", "contract"})
+def _sum_of_squares(x):
+    total = 0.0
+    for i in range(x.size):
+        total += x[i] * x[i]
+    return total
 
 
 def _compiled(*arrays: np.ndarray) -> bool:
@@ -82,3 +92,14 @@ def work_products(u_new: np.ndarray, u_old: np.ndarray, f_old: np.ndarray, f_new
         return out
     _work_products(u_new, u_old, f_old, f_new, out)
     return out
+
+
+def sum_of_squares(x: np.ndarray) -> float:
+    """Σ x_i² (a 1D float array), a non-finite float if x holds a NaN or ±inf or the sum
+    overflows: the test of the integrators' finite-state check. Compiled without numpy's
+    floating-point error state (whose context cost as much as the two products it guarded);
+    its sums run in another order than BLAS's dot, so the value differs by round-off."""
+    if not _compiled(x):
+        with np.errstate(over="ignore", invalid="ignore"):
+            return float(np.dot(x, x))
+    return float(_sum_of_squares(x))
