@@ -167,6 +167,9 @@ def test_timer_splits_the_steps_of_an_explicit_run(clock):
         rep["step_seconds"] - rep["linear_algebra_seconds"]
     )
     assert 0.0 <= rep["overhead_share"] <= 1.0
+    # the energy bookkeeping's products (the coupling's powers here) are a part of the
+    # linear algebra
+    assert 0.0 < rep["energy_products_seconds"] <= rep["linear_algebra_seconds"]
     # the timers change nothing in the run
     assert np.array_equal(plain.contact_pressure, timed.contact_pressure)
     assert np.array_equal(plain.total_energy, timed.total_energy)

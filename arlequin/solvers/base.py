@@ -207,6 +207,7 @@ class Integrator:
         self.a = np.zeros_like(u)
         self.constraint_states = {c.name: c.initial_state(u, v) for c in self.unilateral}
         self._stack_cache: dict = {}  # stack_active's last stacked rows
+        self._active_displacement_rows = False  # whether _active's last rows had any
         self._initialize()
 
     # ------------------------------------------------------------------ scheme hooks
@@ -431,18 +432,20 @@ class Integrator:
         cache = self._stack_cache
         g_a, rhs_a, idx = stack_active(trials, self.ops.n, cache)
         if not idx:
+            self._active_displacement_rows = False
             return g_a, rhs_a, idx, np.zeros(0, dtype=bool)
-        # the rows' levels for the same numbers of active rows per constraint kept, read-only
+        # the rows' levels for the same numbers of active rows per constraint kept, read-only,
+        # with whether any is a displacement-level row (``_active_displacement_rows``)
         key = tuple(a.size for a in idx)
         levels = cache.get("levels")
-        if levels is not None and levels[0] == key:
-            return g_a, rhs_a, idx, levels[1]
-        disp = np.concatenate(
-            [np.full(a.size, c.level == "displacement") for c, a in zip(self.unilateral, idx)]
-        )
-        disp.flags.writeable = False
-        cache["levels"] = (key, disp)
-        return g_a, rhs_a, idx, disp
+        if levels is None or levels[0] != key:
+            disp = np.concatenate(
+                [np.full(a.size, c.level == "displacement") for c, a in zip(self.unilateral, idx)]
+            )
+            disp.flags.writeable = False
+            levels = cache["levels"] = (key, disp, bool(disp.any()))
+        self._active_displacement_rows = levels[2]
+        return g_a, rhs_a, idx, levels[1]
 
     def _full_multipliers(self, lam_a: np.ndarray, idx: Sequence[np.ndarray]) -> list[np.ndarray]:
         return scatter_active(lam_a, idx, [c.n_rows for c in self.unilateral])

@@ -52,7 +52,7 @@ from .registry import register
 from .row_basis import ImpulseBasis
 from .rows import EqualityRows, rows_times, subtract_transposed, unilateral_block_powers
 from .stability import DEFAULT_SAFETY, StableStep, check_time_step, stable_time_step
-from .timing import SWITCH
+from .timing import SWITCH, energy_products_done, energy_products_start
 from .vector_updates import interpolated, scaled_plus, work_products
 
 __all__ = ["DEFAULT_SAFETY", "CentralDifference"]
@@ -295,7 +295,8 @@ class CentralDifference(Integrator):
                 r_e = self._rhs_equality(v_star, u, t_next) if rows.m else r_e0
             # velocity-level rows (contact) target rhs_a itself: no product with u for them
             tic = timer.clock() if timer is not None else 0.0
-            w_a = np.where(disp, (rhs_a - g_a @ u) / dt, rhs_a) if disp.any() else rhs_a
+            w_a = np.where(disp, (rhs_a - g_a @ u) / dt, rhs_a) \
+                if self._active_displacement_rows else rhs_a  # fmt: skip
             r_a = rows_times(g_a, v_star) - w_a
             lam_e, lam_a = solver.solve(r_e, g_a, r_a)
             v_new = v_star.copy()
@@ -403,6 +404,7 @@ class CentralDifference(Integrator):
             lam = self._lam_a / self._dt_bar
             for i, p in enumerate(unilateral_block_powers(self.ops, self._g_a, lam, vs)):
                 out[i, 2] += p
+        tic = energy_products_start()
         for i, x in enumerate(vs):
             if self._f_ext is not None:
                 out[i, 0] = self.ops.block_dots(self._f_ext, x)
@@ -410,6 +412,7 @@ class CentralDifference(Integrator):
                 out[i, 2] += self.ops.block_dots(self._f_applied, x)
             if self._f_damp is not None:
                 out[i, 3] = -self.ops.block_dots(self._f_damp, x)
+        energy_products_done(tic)
         return out[0] if v2 is None else out
 
     def _damping_force(self, v: np.ndarray) -> np.ndarray | None:
@@ -501,8 +504,10 @@ class CentralDifference(Integrator):
             buf = self._work_buffer
             if buf is None or buf.shape != u_new.shape:
                 buf = self._work_buffer = np.empty(u_new.shape)
+            tic = energy_products_start()
             products = work_products(u_new, self.u, self._f_int, f_int, buf)
             self._w_internal += self.ops.block_sums(products)
+            energy_products_done(tic)
         self.u = u_new
         self.a = a_new
         self.states = trial

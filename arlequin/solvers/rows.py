@@ -22,6 +22,7 @@ from .block_sums import signed_block_sums, touched_index
 from .csr import CsrProduct, csr_times, subtract_scaled_transposed
 from .linalg import factor_checked
 from .operators import SystemOperators
+from .timing import energy_products_done, energy_products_start
 
 logger = logging.getLogger(__name__)
 
@@ -258,12 +259,14 @@ def unilateral_block_powers(
         index = touched_index(cols, ops.block_of_dof[cols])
         _TOUCHED[0], _TOUCHED[1] = g, (cols, inv, row_of, *index)
     cols, inv, row_of, idx, block = _TOUCHED[1]
+    tic = energy_products_start()
     force = np.bincount(inv, g.data * lam[row_of], minlength=cols.size)
     out = []
     for x in xs:
         p = np.zeros(nb)
         signed_block_sums(force, x, idx, block, p)
         out.append(p)
+    energy_products_done(tic)
     return out
 
 
@@ -410,6 +413,7 @@ class EqualityRows:
             self._by_kind = [(r, CsrProduct(self.matrix_cols[r].T.tocsr())) for r in kinds]
             self._block_sums = touched_index(self.cols, self.block_of_col)
         idx, block = self._block_sums
+        tic = energy_products_start()
         forces = [bt_times(lam[r]) if r.size else None for r, bt_times in self._by_kind]
         out = []
         for x in vs:
@@ -420,6 +424,7 @@ class EqualityRows:
                     signed_block_sums(f, x, idx, block, p)
                 pair.append(p)
             out.append((pair[0], pair[1]))
+        energy_products_done(tic)
         return out
 
     def row_name(self, i: int) -> str:

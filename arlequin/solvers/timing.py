@@ -12,7 +12,9 @@ What is timed, with ``time.perf_counter`` (or the thread's CPU time, ``clock="th
 * ``kernel``: the nonlinear models' ``internal_force`` calls (the compiled J2 kernels with their
   gathers and assemblies);
 * ``linear_algebra``: sparse mat-vecs (the linear blocks' stiffness, the rows' transfers), the
-  factorised impulse solves and the dense Schur products of contact;
+  factorised impulse solves and the dense Schur products of contact, and the products and
+  per-block sums of the energy bookkeeping (the powers of the constraint forces, Bᵀλ·v and
+  Gᵀλ·v, and the internal work's Δu·f̄), also counted apart in ``energy_products``;
 * ``step``: :meth:`Integrator.step <arlequin.solvers.base.Integrator.step>` as a whole, so
   ``other = step − kernel − linear_algebra`` is the Python layer around them (the overhead).
 """
@@ -21,7 +23,7 @@ from __future__ import annotations
 
 from time import perf_counter, thread_time
 
-__all__ = ["CLOCKS", "SWITCH", "StepTimer"]
+__all__ = ["CLOCKS", "SWITCH", "StepTimer", "energy_products_done", "energy_products_start"]
 
 #: The clocks of the timers: the wall clock, or the CPU time of the calling thread (on a
 #: machine shared with other jobs, the time the step's own Python layer uses, without the
@@ -51,6 +53,8 @@ class StepTimer:
     kernel, linear_algebra, step : float
         Seconds in the models' internal forces, in sparse/dense products and solves, and in
         whole steps (the first two included).
+    energy_products : float
+        The part of ``linear_algebra`` in the energy bookkeeping's products and sums.
     steps : int
         Steps timed.
     first_step : float
@@ -71,6 +75,7 @@ class StepTimer:
         self.clock_name = clock
         self.kernel = 0.0
         self.linear_algebra = 0.0
+        self.energy_products = 0.0
         self.step = 0.0
         self.steps = 0
         self.first_step = 0.0
@@ -86,7 +91,7 @@ class StepTimer:
         if self.skip_first and not self._started:
             self._started = True
             self.first_step = seconds
-            self.kernel = self.linear_algebra = 0.0
+            self.kernel = self.linear_algebra = self.energy_products = 0.0
             return
         self.step += seconds
         self.steps += 1
@@ -112,7 +117,24 @@ class StepTimer:
             "step_seconds": step,
             "kernel_seconds": self.kernel,
             "linear_algebra_seconds": self.linear_algebra,
+            "energy_products_seconds": self.energy_products,
             "other_seconds": self.other,
             "overhead_share": self.other / step if step > 0 else 0.0,
             "steps_per_second": self.steps / step if step > 0 else 0.0,
         }
+
+
+def energy_products_start() -> float:
+    """The clock of the timer switched on (0.0 when off), before an energy product."""
+    timer = SWITCH.timer
+    return timer.clock() if timer is not None else 0.0
+
+
+def energy_products_done(tic: float) -> None:
+    """Count the time since ``tic`` (:func:`energy_products_start`) as linear algebra of the
+    energy bookkeeping (nothing when the timers are off)."""
+    timer = SWITCH.timer
+    if timer is not None:
+        seconds = timer.clock() - tic
+        timer.linear_algebra += seconds
+        timer.energy_products += seconds
