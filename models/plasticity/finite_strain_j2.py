@@ -39,6 +39,18 @@ from .j2 import (
     hencky_strain,
     j2_return_map,
 )
+
+# the compiled kernels at import (a function-level import, at every evaluation, cost more than
+# the smallest patches' kernels); numba compiles or loads each on its first call only
+from .j2_kernel import (
+    assemble_cell_forces,
+    assembly_dofs,
+    min_scaled_cell_size,
+    planar_j2_kernel,
+    run_kernel,
+    scratch,
+)
+from .j2_kernel_3d import solid_j2_kernel, solid_scratch
 from .kinematics import KINDS, Q1Kinematics  # noqa: F401  (KINDS re-exported)
 
 __all__ = [
@@ -402,8 +414,6 @@ class FiniteStrainJ2(CellStates):
     def _internal_force_numba(self, u, state, alpha, dt):
         if self.dim == 3:
             return self._internal_force_numba_3d(u, state, alpha, dt)
-        from .j2_kernel import planar_j2_kernel, run_kernel, scratch
-
         kin = self.kin
         ne, nq = self.shape
         nen = kin.grad.shape[0]
@@ -432,9 +442,6 @@ class FiniteStrainJ2(CellStates):
         return self._gathered(out, dofs)
 
     def _internal_force_numba_3d(self, u, state, alpha, dt):
-        from .j2_kernel import run_kernel
-        from .j2_kernel_3d import solid_j2_kernel, solid_scratch
-
         kin = self.kin
         ne, nq = self.shape
         nen = kin.grad.shape[0]
@@ -510,8 +517,6 @@ class FiniteStrainJ2(CellStates):
 
     def _gathered(self, out: list[np.ndarray], cell_dofs: np.ndarray):
         """The kernel's outputs (its dofs ``cell_dofs``) as (force, state); flagged cells raise."""
-        from .j2_kernel import assemble_cell_forces, assembly_dofs
-
         fe, cp_inv, eqps, tau, J, wp, wv, flags = out
         if self._assembly is None or self._assembly[0] is not cell_dofs:
             self._assembly = (cell_dofs, assembly_dofs(cell_dofs))
@@ -586,8 +591,6 @@ class FiniteStrainJ2(CellStates):
             per_cell = element_critical_step(self.elastic, self.elastic.basis, per_cell=True)
             self._critical_ratio = per_cell * cd / self.kin.cell_sizes(self.mesh.p)
         if self.backend == "numba" and self.dim == 2:  # the same floats, compiled
-            from .j2_kernel import min_scaled_cell_size
-
             if self._size_arrays is None:  # one type for the compiled loop whatever the mesh's
                 c, i8 = np.ascontiguousarray, np.int64
                 self._size_arrays = (
