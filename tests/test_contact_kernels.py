@@ -20,7 +20,7 @@ from arlequin.models import (
     SphereObstacle,
 )
 from arlequin.models.contact.kernel import (
-    equal_at,
+    equal_gathered,
     level_set_begin,
     level_set_status,
     plane_gaps,
@@ -90,18 +90,19 @@ def test_level_set_status_kernels_equal_numpy(seed):
     assert not level_set_status(g.indptr, g.indices, g.data, v, lam, kappa, s_d, new)[3]
 
 
-def test_equal_at():
-    a = np.arange(10.0)
-    b = a.copy()
+def test_equal_gathered():
+    # reference: (values == b[idx]).all(), NaN never equal and 0.0 == -0.0 as with ==
+    b = np.arange(10.0)
     idx = np.array([1, 4, 7])
-    assert equal_at(a, b, idx)
+    values = b[idx]
+    assert equal_gathered(values, b, idx)
     b[5] = -1.0  # outside idx
-    assert equal_at(a, b, idx)
+    assert equal_gathered(values, b, idx)
     b[7] = np.nan
-    assert not equal_at(a, b, idx)
-    a[7] = np.nan  # NaN is never equal, as with ==
-    assert not equal_at(a, b, idx)
-    assert equal_at(np.array([0.0]), np.array([-0.0]), np.array([0]))
+    assert not equal_gathered(values, b, idx)
+    values[2] = np.nan  # NaN is never equal, as with ==
+    assert not equal_gathered(values, b, idx)
+    assert equal_gathered(np.array([0.0]), np.array([-0.0]), np.array([0]))
 
 
 def test_evolve_and_build_as_dataclasses():

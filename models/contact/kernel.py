@@ -23,7 +23,7 @@ import numpy as np
 from numba import njit
 
 __all__ = [
-    "equal_at",
+    "equal_gathered",
     "level_set_begin",
     "level_set_status",
     "plane_gaps",
@@ -227,11 +227,11 @@ def level_set_status(indptr: np.ndarray, indices: np.ndarray, data: np.ndarray, 
 
 
 @njit(cache=True)
-def equal_at(a: np.ndarray, b: np.ndarray, idx: np.ndarray) -> bool:
-    """``bool((a[idx] == b[idx]).all())`` for vectors a, b and indices idx, without the two
-    gathers: False at the first difference (a moving contact's first dof, most steps)."""
-    for j in idx:
-        if a[j] != b[j]:
+def equal_gathered(values: np.ndarray, b: np.ndarray, idx: np.ndarray) -> bool:
+    """``bool((values == b[idx]).all())`` for gathered values (k,), a vector b and indices idx
+    (k,), without the gather: False at the first difference."""
+    for k in range(idx.size):
+        if values[k] != b[idx[k]]:
             return False
     return True
 

@@ -93,7 +93,7 @@ from .geometry import (
     csr_with_data,
 )
 from .kernel import (
-    equal_at,
+    equal_gathered,
     level_set_begin,
     level_set_status,
     rows_times_sum,
@@ -265,6 +265,11 @@ class _ContactConstraint:
             return ContactGeometry(self._geo0.rows, gap, self._geo0.normal, self._geo0.jump)
         return self.pair.geometry(u)
 
+    def _u_geometry(self, u: np.ndarray) -> np.ndarray:
+        """What a state keeps of the u its geometry was made at: u on the pair's geometry
+        dofs (a new array), or a copy of u if the pair does not name them."""
+        return u.copy() if self._gdofs is None else u[self._gdofs]
+
     def _geometry_from(self, state: ContactState, u: np.ndarray) -> ContactGeometry:
         last = state.u_geometry
         if last is u:
@@ -272,12 +277,16 @@ class _ContactConstraint:
         # the geometry depends on the pair's dofs alone: compared there (a few hundred values,
         # not the whole system's at every step); == and all() as array_equal for equal shapes
         dofs = self._gdofs
-        if last.shape != u.shape or u.shape != (self.pair.n_dofs,):
+        if u.shape != (self.pair.n_dofs,):
             same = False
-        elif dofs is None or last.dtype != np.float64 or u.dtype != np.float64:
-            same = bool((last == u).all() if dofs is None else (last[dofs] == u[dofs]).all())
+        elif dofs is None:
+            same = last.shape == u.shape and bool((last == u).all())
+        elif last.shape != dofs.shape:  # not kept on the geometry dofs (an older state)
+            same = False
+        elif last.dtype != np.float64 or u.dtype != np.float64:
+            same = bool((last == u[dofs]).all())
         else:
-            same = equal_at(last, u, dofs)
+            same = equal_gathered(last, u, dofs)
         if same:
             return state.geometry
         return self.pair.geometry(u) if self.update_geometry else self.geometry(u)
@@ -294,7 +303,7 @@ class _ContactConstraint:
             None,
             np.zeros(m),
             self.geometry(u),
-            u.copy(),
+            self._u_geometry(u),
             np.zeros(m),
         )
 
@@ -372,9 +381,9 @@ class _ContactConstraint:
         if state.impulse is not None:
             total = state.impulse + total
         # the trial's arrays are the constraint's own (update_status copied the multipliers),
-        # never modified: kept without copies; u is the integrator's, copied
+        # never modified: kept without copies; u is the integrator's: its geometry dofs copied
         return build(ContactState, active=trial.used, work=work, record=record,
-                     multipliers=trial.lam, geometry=geo_end, u_geometry=u.copy(),
+                     multipliers=trial.lam, geometry=geo_end, u_geometry=self._u_geometry(u),
                      impulse=total)  # fmt: skip
 
     def history(self, result: Any) -> ContactHistory:

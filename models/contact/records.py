@@ -148,7 +148,9 @@ class ContactState:
         λ_v (Pa) of the last accepted step.
     geometry : ContactGeometry
         Gaps and rows at ``u_geometry`` (reused by the next step when it starts there).
-    u_geometry : ndarray, shape (n,)
+    u_geometry : ndarray, shape (k,)
+        u (m) on the pair's geometry dofs (``geometry_dofs``, k of them) where ``geometry``
+        was made, or the whole u (n,) for a pair that does not name them.
     impulse : ndarray, shape (m,) or None
         Accumulated ∫λ_v dt at each collocation point (Pa·s): the force on the rows over any
         interval is −Σ w Δimpulse / Δt (N) with the collocation weights w.
