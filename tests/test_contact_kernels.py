@@ -196,6 +196,28 @@ def test_constraint_step_against_the_numpy_reference():
         trial.rhs[0] = 1.0  # the shared zeros of the trials are read-only
 
 
+def test_state_keeps_u_on_the_geometry_dofs_and_reuses_its_geometry():
+    # a state keeps u on the pair's geometry dofs; a step starting from that u reuses the
+    # state's geometry object, any other u (or a state of the earlier full-size form, or a
+    # float32 u) gets the geometry computed afresh, equal to the pair's own
+    surface, n = bar_surface()
+    pair = RigidContactPair(surface, PlaneObstacle([0.0, -1e-3], [0.3, 1.0]), n)
+    con = LevelSetContact(pair, kappa=4e7)
+    rng = np.random.default_rng(2)
+    u = rng.standard_normal(n) * 1e-4
+    state = con.initial_state(u, np.zeros(n))
+    assert same_bytes(state.u_geometry, u[pair.geometry_dofs])
+    assert con._geometry_from(state, u.copy()) is state.geometry
+    moved = u.copy()
+    moved[pair.geometry_dofs[-1]] += 1e-9
+    assert same_bytes(con._geometry_from(state, moved).gap, pair.geometry(moved).gap)
+    older = dataclasses.replace(state, u_geometry=u.copy())  # full-size: not compared
+    assert con._geometry_from(older, u) is not state.geometry
+    u32 = u.astype(np.float32)
+    same32 = dataclasses.replace(state, u_geometry=u32[pair.geometry_dofs])
+    assert con._geometry_from(same32, u32) is state.geometry  # compared by the gather path
+
+
 def test_stack_active_kept_patterns_equal_a_fresh_stacking():
     # reference: stack_active without a cache (the rows stacked afresh at every call)
     rng = np.random.default_rng(2)

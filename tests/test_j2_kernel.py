@@ -284,6 +284,15 @@ def test_compiled_critical_step_is_the_numpy_estimate_bit_for_bit():
     crushed[compiled.nodal_dofs()[1]] = -0.5 * mesh.p[1]  # half as tall: a smaller step
     assert compiled.critical_time_step(crushed) == reference.critical_time_step(crushed)
     assert compiled.critical_time_step(crushed) < compiled.critical_time_step(0.0 * crushed)
+    # a cell collapsed to a point (0/0): NaN from both, not a skipped cell
+    collapsed = np.zeros(compiled.n_dofs)
+    nodes = mesh.t[:, 0]
+    dofs = compiled.nodal_dofs()
+    for k in range(4):
+        collapsed[dofs[:, nodes[k]]] = mesh.p[:, nodes[0]] - mesh.p[:, nodes[k]]
+    with np.errstate(invalid="ignore"):
+        assert np.isnan(reference.critical_time_step(collapsed))
+    assert np.isnan(compiled.critical_time_step(collapsed))
 
 
 @pytest.mark.parametrize("kind", ["axisymmetric", "plane_strain"])

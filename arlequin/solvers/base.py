@@ -19,7 +19,7 @@ import logging
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -46,6 +46,14 @@ STATUSES = ("running", "finished", "failed")
 
 #: Relative tolerance (of the step) within which a time counts as a stop time.
 _LANDING = 1e-9
+
+
+class _ActiveLevels(NamedTuple):
+    """The levels of stacked active rows, kept for their counts per constraint."""
+
+    counts: tuple[int, ...]
+    displacement: np.ndarray  # (m_A,) bool, read-only: a displacement-level row
+    any_displacement: bool
 
 
 @dataclass(frozen=True)
@@ -207,7 +215,9 @@ class Integrator:
         self.a = np.zeros_like(u)
         self.constraint_states = {c.name: c.initial_state(u, v) for c in self.unilateral}
         self._stack_cache: dict = {}  # stack_active's last stacked rows
-        self._active_displacement_rows = False  # whether _active's last rows had any
+        # whether the last active rows (_active) had a displacement-level row: their impulse
+        # right-hand side needs G_A u then
+        self._active_displacement_rows = False
         self._initialize()
 
     # ------------------------------------------------------------------ scheme hooks
@@ -436,16 +446,16 @@ class Integrator:
             return g_a, rhs_a, idx, np.zeros(0, dtype=bool)
         # the rows' levels for the same numbers of active rows per constraint kept, read-only,
         # with whether any is a displacement-level row (``_active_displacement_rows``)
-        key = tuple(a.size for a in idx)
+        counts = tuple(a.size for a in idx)
         levels = cache.get("levels")
-        if levels is None or levels[0] != key:
+        if levels is None or levels.counts != counts:
             disp = np.concatenate(
                 [np.full(a.size, c.level == "displacement") for c, a in zip(self.unilateral, idx)]
             )
             disp.flags.writeable = False
-            levels = cache["levels"] = (key, disp, bool(disp.any()))
-        self._active_displacement_rows = levels[2]
-        return g_a, rhs_a, idx, levels[1]
+            levels = cache["levels"] = _ActiveLevels(counts, disp, bool(disp.any()))
+        self._active_displacement_rows = levels.any_displacement
+        return g_a, rhs_a, idx, levels.displacement
 
     def _full_multipliers(self, lam_a: np.ndarray, idx: Sequence[np.ndarray]) -> list[np.ndarray]:
         return scatter_active(lam_a, idx, [c.n_rows for c in self.unilateral])

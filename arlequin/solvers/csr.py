@@ -37,13 +37,14 @@ PARALLEL_MIN_NNZ = 1_000_000
 
 @nb.njit(cache=True)
 def csr_times(indptr, indices, data, x, y):
-    """y = A x for A in CSR form (indptr uint64, indices uint32, data float64): each row's
+    """y = A x for A in CSR form (any integer indices: :class:`CsrProduct` passes uint64 and
+    uint32, the faster ones, and the active contact rows scipy's own), data float64: each row's
     products added in stored order from zero, as scipy's ``csr_matvec``.
 
     Parameters
     ----------
-    indptr : ndarray of uint64, shape (n_rows + 1,)
-    indices : ndarray of uint32, shape (nnz,)
+    indptr : ndarray of int, shape (n_rows + 1,)
+    indices : ndarray of int, shape (nnz,)
     data : ndarray of float64, shape (nnz,)
     x : ndarray of float64, shape (n_cols,)
     y : ndarray of float64, shape (n_rows,)
@@ -109,7 +110,7 @@ def subtract_scaled_transposed(indptr, indices, data, lam, scale, v, acc):
     for i in range(m):
         for k in range(indptr[i], indptr[i + 1]):
             j = indices[k]
-            # a column met again subtracts scale·0: the same bits (v − (±0) = v)
+            # a column met again subtracts scale·0 = +0 (scale > 0: M⁻¹): v − (+0) = v
             v[j] -= acc[j] * scale[j]
             acc[j] = 0.0
 

@@ -182,11 +182,14 @@ class ImpulseSolver:
     def _cholesky(schur: np.ndarray, m_a: int):
         """Upper Cholesky factor of the dense (Schur complement) matrix of the active rows.
 
-        Raises :class:`ConstraintError` if it is not positive definite, or if a pivot keeps
-        less than 1e-14 of its row's diagonal (a row dependent on the others to round-off: the
-        threshold of :class:`~arlequin.solvers.linalg.ScaledLU` after its diagonal scaling)."""
+        Raises :class:`ConstraintError` if it is not positive definite or not finite, or if a
+        pivot keeps less than 1e-14 of its row's diagonal (a row dependent on the others to
+        round-off; :class:`~arlequin.solvers.linalg.ScaledLU` applies 1e-14 to its pivots after
+        a diagonal scaling, relative to the largest)."""
         msg = ("active unilateral rows are dependent on each other or on the equality rows "
                f"({m_a} active rows)")  # fmt: skip
+        if not np.isfinite(schur).all():
+            raise ConstraintError(f"the impulse matrix of the {m_a} active rows is not finite")
         try:
             cho = dense_cho_factor(schur)
         except np.linalg.LinAlgError as exc:
@@ -256,7 +259,9 @@ class ImpulseSolver:
 
 
 class _DenseFactor:
-    """A dense Cholesky factor with the ``solve`` of the sparse factorisations."""
+    """A dense Cholesky factor with the ``solve`` of the sparse factorisations: a non-finite
+    right-hand side gives non-finite impulses, as theirs do (the integrator's finite-state
+    check then fails the step), rather than a ``ValueError`` from LAPACK's wrapper."""
 
     __slots__ = ("cho",)
 
@@ -264,12 +269,17 @@ class _DenseFactor:
         self.cho = cho
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
+        rhs = np.asarray(rhs, dtype=float)
+        if not np.isfinite(rhs).all():
+            return np.full(rhs.shape, np.nan)
         return dense_cho_solve(self.cho, rhs)
 
 
 class _DiagonalFactor:
-    """Independent rows: x = r / diag by the products of :class:`ScaledLU`'s diagonal path
-    (``(1 / d) * r``, the same bits), with its test of an empty row."""
+    """Independent rows: x = (1 / d) r, the arithmetic of :class:`ScaledLU`'s diagonal path,
+    with its test of an empty row. The diagonal d comes from a dense product: the same bits as
+    the sparse product's when each row has one non-zero entry (walls along an axis), to
+    round-off otherwise."""
 
     __slots__ = ("inv",)
 

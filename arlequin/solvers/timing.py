@@ -13,8 +13,9 @@ What is timed, with ``time.perf_counter`` (or the thread's CPU time, ``clock="th
   gathers and assemblies);
 * ``linear_algebra``: sparse mat-vecs (the linear blocks' stiffness, the rows' transfers), the
   factorised impulse solves and the dense Schur products of contact, and the products and
-  per-block sums of the energy bookkeeping (the powers of the constraint forces, Bᵀλ·v and
-  Gᵀλ·v, and the internal work's Δu·f̄), also counted apart in ``energy_products``;
+  per-block sums of the energy bookkeeping (the powers of the constraint forces Bᵀλ·v and
+  Gᵀλ·v, of the external, friction and damping forces, and the internal work's Δu·f̄), also
+  counted apart in ``energy_products``;
 * ``step``: :meth:`Integrator.step <arlequin.solvers.base.Integrator.step>` as a whole, so
   ``other = step − kernel − linear_algebra`` is the Python layer around them (the overhead).
 """

@@ -48,8 +48,8 @@ from .j2_kernel import (
     min_scaled_cell_size,
     planar_j2_kernel,
     run_kernel,
-    scratch,
 )
+from .j2_kernel import scratch as planar_scratch
 from .j2_kernel_3d import solid_j2_kernel, solid_scratch
 from .kinematics import KINDS, Q1Kinematics  # noqa: F401  (KINDS re-exported)
 
@@ -425,7 +425,7 @@ class FiniteStrainJ2(CellStates):
                 c(np.transpose(kin.cell_dofs, (2, 1, 0)), dtype=np.int64),
                 c(np.moveaxis(kin.grad, (0, 1), (2, 3))), c(np.moveaxis(kin.val, 0, -1)),
                 c(radius), c(kin.dv0),
-                visc, c(self._h0), *scratch(nq, nen),
+                visc, c(self._h0), *planar_scratch(nq, nen),
             )  # fmt: skip
         dofs, grad, val, radius, dv0, visc, h0, s_h, s_g, s_u = self._kernel_static
         u = self._checked_displacement(u)

@@ -152,8 +152,10 @@ def min_scaled_cell_size(p, cells, dofs, u, ratio):
         area = 0.5 * abs((x[0, 2] - x[0, 0]) * (x[1, 3] - x[1, 1])
                          - (x[0, 3] - x[0, 1]) * (x[1, 2] - x[1, 0]))  # fmt: skip
         h = ratio[e] * (area / math.sqrt(longest2))
-        if h < best:
+        if h < best or h != h:  # a NaN (a collapsed cell: 0/0) kept, as np.min keeps it
             best = h
+            if h != h:
+                return h
     return best
 
 
@@ -421,9 +423,10 @@ def planar_j2_kernel(
             fy = norm - SQRT23 * _flow(code, prm, ep, 0.0)
             dg = 0.0
             if fy > 0.0 and code == 0:
-                # linear hardening: Δγ of _plastic_multiplier's first line, here rather than
-                # through its call (not inlined: the point's live values spilled around it,
-                # 7% of the kernel on one core at nr = 30)
+                # linear hardening: Δγ of _plastic_multiplier's first line (equal to rounding:
+                # here the kernel's fastmath may fuse its products), here rather than through
+                # its call (not inlined: the point's live values spilled around it, 7% of the
+                # kernel on one core at nr = 30); H ≥ 0, so Δγ > 0
                 dg = fy / (2.0 * G + 2.0 / 3.0 * prm[1])
             elif fy > 0.0:
                 dg = _plastic_multiplier(norm, ep, code, prm, G, dt)
