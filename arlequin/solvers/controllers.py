@@ -36,6 +36,8 @@ __all__ = [
 
 def check_step(dt: float, what: str = "time step") -> float:
     """``dt`` as a float, or ``ValueError`` naming it unless it is positive and finite."""
+    if type(dt) is float and 0.0 < dt < math.inf:  # the common case, at every step
+        return dt
     if isinstance(dt, (str, bool)):
         raise ValueError(f"{what} must be a positive number of seconds, got {dt!r}")
     try:

@@ -492,8 +492,11 @@ class CentralDifference(Integrator):
         f_damp = self._damping_force(v_half)  # −C v^{n+1/2}: the damping force at t_{n+1}
         a_new = self._acceleration(f_int if f_damp is None else f_int + f_damp, f_ext)
         # the step size at t is final now: commit the works of the step that ended at t
-        self._w_ext, self._w_coupling, self._w_constraint = self._works()
-        self._w_damping = self._damping_work()
+        pe, pc, po, pd = self._w_pending  # _works() and _damping_work(), inline
+        self._w_ext = self._w_ext + pe
+        self._w_coupling = self._w_coupling + pc
+        self._w_constraint = self._w_constraint + po
+        self._w_damping = self._w_damping + pd
         # the forces at t with this step's velocity (computed with the impulse at t)
         cached = getattr(self, "_p_next", None)
         self._p_prev = cached[1] if cached is not None and cached[0] is v_half else \
