@@ -30,6 +30,10 @@ from skfem import Basis, Mesh
 from arlequin.contract import CellStates, StateError
 
 from ..elastic import LinearElastic, WeightLike, element_critical_step
+
+# the compiled kernels' modules at import (a function-level import at every evaluation cost
+# several µs); numba compiles or loads each kernel on its first call only
+from . import j2_kernel, j2_kernel_3d
 from .array_pool import ArrayPool
 from .j2 import (
     InvertedElementError,
@@ -39,18 +43,6 @@ from .j2 import (
     hencky_strain,
     j2_return_map,
 )
-
-# the compiled kernels at import (a function-level import, at every evaluation, cost more than
-# the smallest patches' kernels); numba compiles or loads each on its first call only
-from .j2_kernel import (
-    assemble_cell_forces,
-    assembly_dofs,
-    min_scaled_cell_size,
-    planar_j2_kernel,
-    run_kernel,
-)
-from .j2_kernel import scratch as planar_scratch
-from .j2_kernel_3d import solid_j2_kernel, solid_scratch
 from .kinematics import KINDS, Q1Kinematics  # noqa: F401  (KINDS re-exported)
 
 __all__ = [
@@ -158,7 +150,7 @@ class FiniteStrainJ2(CellStates):
         self._h0 = np.sqrt(area) if dim == 2 else np.cbrt(area)
         self._critical_ratio: np.ndarray | None = None
         self._size_arrays: tuple | None = None  # the compiled critical step's mesh arrays
-        self._wave_speed: tuple | None = None  # (the material, its c_d (m/s)) of the last estimate
+        self._wave_speed: float | None = None  # c_d (m/s), for the critical step
         self._kernel_static: tuple | None = None  # contiguous inputs and scratch of the kernel
         self._ones: np.ndarray | None = None
         self._alpha_of: tuple | None = None  # (read-only weight, its checked broadcast)
@@ -425,15 +417,15 @@ class FiniteStrainJ2(CellStates):
                 c(np.transpose(kin.cell_dofs, (2, 1, 0)), dtype=np.int64),
                 c(np.moveaxis(kin.grad, (0, 1), (2, 3))), c(np.moveaxis(kin.val, 0, -1)),
                 c(radius), c(kin.dv0),
-                visc, c(self._h0), *planar_scratch(nq, nen),
+                visc, c(self._h0), *j2_kernel.scratch(nq, nen),
             )  # fmt: skip
         dofs, grad, val, radius, dv0, visc, h0, s_h, s_g, s_u = self._kernel_static
         u = self._checked_displacement(u)
         out = self._kernel_outputs(2)
         c = np.ascontiguousarray
         weight, K, G, code, prm = self._kernel_constants(alpha)
-        run_kernel(
-            planar_j2_kernel, ne, u, dofs, grad, val, radius, dv0, weight,
+        j2_kernel.run_kernel(
+            j2_kernel.planar_j2_kernel, ne, u, dofs, grad, val, radius, dv0, weight,
             self.kind == "axisymmetric", self.fbar, K, G, code, prm,
             -1.0 if dt is None else float(dt), c(state.cp_inv), c(state.eqps),
             c(state.plastic_work), c(state.viscous_work), c(state.jacobian), visc, h0,
@@ -450,15 +442,15 @@ class FiniteStrainJ2(CellStates):
             self._kernel_static = (
                 c(np.transpose(kin.cell_dofs, (2, 1, 0)), dtype=np.int64),
                 c(np.moveaxis(kin.grad, (0, 1), (2, 3))), c(kin.dv0), self._viscosity_params(),
-                c(self._h0), *solid_scratch(nq, nen),
+                c(self._h0), *j2_kernel_3d.solid_scratch(nq, nen),
             )  # fmt: skip
         dofs, grad, dv0, visc, h0, s_h, s_g, s_m = self._kernel_static
         u = self._checked_displacement(u)
         out = self._kernel_outputs(3)
         weight, K, G, code, prm = self._kernel_constants(alpha)
-        run_kernel(
-            solid_j2_kernel, ne, u, dofs, grad, dv0, weight, self.fbar, K, G, code, prm,
-            -1.0 if dt is None else float(dt), c(state.cp_inv), c(state.eqps),
+        j2_kernel.run_kernel(
+            j2_kernel_3d.solid_j2_kernel, ne, u, dofs, grad, dv0, weight, self.fbar, K, G, code,
+            prm, -1.0 if dt is None else float(dt), c(state.cp_inv), c(state.eqps),
             c(state.plastic_work), c(state.viscous_work), c(state.jacobian), visc, h0,
             s_h, s_g, s_m, *out,
         )  # fmt: skip
@@ -519,9 +511,9 @@ class FiniteStrainJ2(CellStates):
         """The kernel's outputs (its dofs ``cell_dofs``) as (force, state); flagged cells raise."""
         fe, cp_inv, eqps, tau, J, wp, wv, flags = out
         if self._assembly is None or self._assembly[0] is not cell_dofs:
-            self._assembly = (cell_dofs, assembly_dofs(cell_dofs))
+            self._assembly = (cell_dofs, j2_kernel.assembly_dofs(cell_dofs))
         f = np.empty(self.kin.n_dofs)
-        if assemble_cell_forces(self._assembly[1], fe, flags, f):
+        if j2_kernel.assemble_cell_forces(self._assembly[1], fe, flags, f):
             bad = np.nonzero(flags)[0]
             cell = int(bad[0])
             if flags[cell] == 1:
@@ -582,11 +574,9 @@ class FiniteStrainJ2(CellStates):
         calibrated once per cell so that at u = 0 it is the element eigenvalue bound of
         :func:`~arlequin.models.elastic.element_critical_step` (a lower bound of the critical
         step): cheap enough to follow crushed cells. Capability ``"critical_time_step"``."""
-        # c_d of the material, kept (its moduli from E and ν: 8 µs a call, every estimate)
-        kept = self._wave_speed
-        if kept is None or kept[0] is not self.material:
-            kept = self._wave_speed = (self.material, self.material.dilatational_wave_speed)
-        cd = kept[1]
+        if self._wave_speed is None:  # the material is frozen: c_d once (8 µs a call)
+            self._wave_speed = self.material.dilatational_wave_speed
+        cd = self._wave_speed
         if self._critical_ratio is None:
             per_cell = element_critical_step(self.elastic, self.elastic.basis, per_cell=True)
             self._critical_ratio = per_cell * cd / self.kin.cell_sizes(self.mesh.p)
@@ -599,7 +589,7 @@ class FiniteStrainJ2(CellStates):
                     c(self.kin.dofs, i8),
                 )
             args = (*self._size_arrays, self._checked_displacement(u), self._critical_ratio)
-            return float(min_scaled_cell_size(*args) / cd)
+            return float(j2_kernel.min_scaled_cell_size(*args) / cd)
         h = self.kin.cell_sizes(self.current_coordinates(u))
         return float(np.min(self._critical_ratio * h) / cd)
 
