@@ -22,6 +22,7 @@ from arlequin.solvers.timing import SWITCH, StepTimer
 from arlequin.solvers.vector_updates import (
     interpolated,
     scaled_plus,
+    subtract_scaled_at,
     sum_of_squares,
     work_products,
 )
@@ -112,6 +113,12 @@ def test_compiled_vector_updates_are_the_numpy_lines_bit_for_bit():
         f *= 0.5
         ref = (x - y) * f
         assert work_products(x, y, z, w, np.empty(n)).tobytes() == ref.tobytes()
+        if n:
+            cols = rng.choice(n, n // 2 + 1, replace=False)
+            got, ref = z.copy(), z.copy()
+            ref[cols] -= x[: cols.size] * y[: cols.size]
+            subtract_scaled_at(got, cols, x[: cols.size], y[: cols.size])
+            assert got.tobytes() == ref.tobytes()
     # other layouts take the numpy lines themselves
     x = np.arange(10.0)[::2]
     np.testing.assert_array_equal(scaled_plus(2.0, x, x), 3.0 * x)

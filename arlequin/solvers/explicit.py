@@ -53,7 +53,7 @@ from .row_basis import ImpulseBasis
 from .rows import EqualityRows, rows_times, subtract_transposed, unilateral_block_powers
 from .stability import DEFAULT_SAFETY, StableStep, check_time_step, stable_time_step
 from .timing import SWITCH, energy_products_done, energy_products_start
-from .vector_updates import interpolated, scaled_plus, work_products
+from .vector_updates import interpolated, scaled_plus, subtract_scaled_at, work_products
 
 __all__ = ["DEFAULT_SAFETY", "CentralDifference"]
 
@@ -272,7 +272,7 @@ class CentralDifference(Integrator):
             lam_e = solver.solve_equality(r_e)
             v_new = v_star
             if rows.m:
-                v_new[rows.cols] -= self._minv_cols * rows.transpose_times(lam_e)
+                subtract_scaled_at(v_new, rows.cols, self._minv_cols, rows.transpose_times(lam_e))
             self.status_iterations = 0
             if timer is not None:
                 timer.linear_algebra += timer.clock() - tic
@@ -301,7 +301,7 @@ class CentralDifference(Integrator):
             lam_e, lam_a = solver.solve(r_e, g_a, r_a)
             v_new = v_star.copy()
             if rows.m:
-                v_new[rows.cols] -= self._minv_cols * rows.transpose_times(lam_e)
+                subtract_scaled_at(v_new, rows.cols, self._minv_cols, rows.transpose_times(lam_e))
             if g_a.shape[0]:
                 # M⁻¹ Gᵀλ subtracted on G_A's columns alone (no n-vector for a few rows)
                 scratch = self._columns_scratch

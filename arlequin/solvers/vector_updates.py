@@ -17,7 +17,13 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-__all__ = ["interpolated", "scaled_plus", "sum_of_squares", "work_products"]
+__all__ = [
+    "interpolated",
+    "scaled_plus",
+    "subtract_scaled_at",
+    "sum_of_squares",
+    "work_products",
+]
 
 
 @nb.njit(cache=True)
@@ -46,6 +52,13 @@ def _sum_of_squares(x):
     for i in range(x.size):
         total += x[i] * x[i]
     return total
+
+
+@nb.njit(cache=True)
+def _subtract_scaled_at(v, cols, scale, x):
+    for j in range(cols.size):
+        c = cols[j]
+        v[c] = v[c] - scale[j] * x[j]
 
 
 def _compiled(*arrays: np.ndarray) -> bool:
@@ -103,3 +116,14 @@ def sum_of_squares(x: np.ndarray) -> float:
         with np.errstate(over="ignore", invalid="ignore"):
             return float(np.dot(x, x))
     return float(_sum_of_squares(x))
+
+
+def subtract_scaled_at(v: np.ndarray, cols: np.ndarray, scale: np.ndarray, x: np.ndarray) -> None:
+    """``v[cols] -= scale * x`` in place for distinct indices ``cols`` (k,) and ``scale``, ``x``
+    (k,): the bits of the numpy line (each entry's product, then its subtraction) in one pass,
+    without its gather, temporary and scatter (the equality rows' impulse, every step)."""
+    if not (_compiled(v) and _compiled(scale, x) and cols.shape == x.shape and cols.ndim == 1
+            and cols.dtype.kind in "iu"):  # fmt: skip
+        v[cols] -= scale * x
+        return
+    _subtract_scaled_at(v, cols, scale, x)
