@@ -17,13 +17,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-__all__ = [
-    "interpolated",
-    "scaled_plus",
-    "subtract_scaled_at",
-    "sum_of_squares",
-    "work_products",
-]
+__all__ = ["interpolated", "scaled_plus", "subtract_scaled_at", "sum_of_squares", "work_products"]
 
 
 @nb.njit(cache=True)
