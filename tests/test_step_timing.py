@@ -117,7 +117,7 @@ def test_compiled_vector_updates_are_the_numpy_lines_bit_for_bit():
             cols = rng.choice(n, n // 2 + 1, replace=False)
             got, ref = z.copy(), z.copy()
             ref[cols] -= x[: cols.size] * y[: cols.size]
-            subtract_scaled_at(got, cols, x[: cols.size], y[: cols.size])
+            subtract_scaled_at(got, cols, x[: cols.size].copy(), y[: cols.size].copy())
             assert got.tobytes() == ref.tobytes()
     # other layouts take the numpy lines themselves
     x = np.arange(10.0)[::2]

@@ -53,7 +53,7 @@ from .row_basis import ImpulseBasis
 from .rows import EqualityRows, rows_times, subtract_transposed, unilateral_block_powers
 from .stability import DEFAULT_SAFETY, StableStep, check_time_step, stable_time_step
 from .timing import SWITCH, energy_products_done, energy_products_start
-from .vector_updates import interpolated, scaled_plus, subtract_scaled_at, work_products
+from .vector_updates import interpolated, scaled_plus, work_products
 
 __all__ = ["DEFAULT_SAFETY", "CentralDifference"]
 
@@ -272,7 +272,7 @@ class CentralDifference(Integrator):
             lam_e = solver.solve_equality(r_e)
             v_new = v_star
             if rows.m:
-                subtract_scaled_at(v_new, rows.cols, self._minv_cols, rows.transpose_times(lam_e))
+                rows.subtract_at_cols(v_new, self._minv_cols, rows.transpose_times(lam_e))
             self.status_iterations = 0
             if timer is not None:
                 timer.linear_algebra += timer.clock() - tic
@@ -301,7 +301,7 @@ class CentralDifference(Integrator):
             lam_e, lam_a = solver.solve(r_e, g_a, r_a)
             v_new = v_star.copy()
             if rows.m:
-                subtract_scaled_at(v_new, rows.cols, self._minv_cols, rows.transpose_times(lam_e))
+                rows.subtract_at_cols(v_new, self._minv_cols, rows.transpose_times(lam_e))
             if g_a.shape[0]:
                 # M⁻¹ Gᵀλ subtracted on G_A's columns alone (no n-vector for a few rows)
                 scratch = self._columns_scratch
@@ -492,11 +492,8 @@ class CentralDifference(Integrator):
         f_damp = self._damping_force(v_half)  # −C v^{n+1/2}: the damping force at t_{n+1}
         a_new = self._acceleration(f_int if f_damp is None else f_int + f_damp, f_ext)
         # the step size at t is final now: commit the works of the step that ended at t
-        pe, pc, po, pd = self._w_pending  # _works() and _damping_work(), inline
-        self._w_ext = self._w_ext + pe
-        self._w_coupling = self._w_coupling + pc
-        self._w_constraint = self._w_constraint + po
-        self._w_damping = self._w_damping + pd
+        self._w_ext, self._w_coupling, self._w_constraint = self._works()
+        self._w_damping = self._damping_work()
         # the forces at t with this step's velocity (computed with the impulse at t)
         cached = getattr(self, "_p_next", None)
         self._p_prev = cached[1] if cached is not None and cached[0] is v_half else \

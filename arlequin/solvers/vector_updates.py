@@ -49,7 +49,13 @@ def _sum_of_squares(x):
 
 
 @nb.njit(cache=True)
-def _subtract_scaled_at(v, cols, scale, x):
+def subtract_scaled_at(v, cols, scale, x):
+    """``v[cols] -= scale * x`` in place (v float64 (n,), distinct indices ``cols`` (k,),
+    ``scale`` and ``x`` float64 (k,)): the bits of the numpy line (each entry's product, then
+    its subtraction) in one pass, without its gather, temporary and scatter. The indices are
+    not checked: :meth:`EqualityRows.subtract_at_cols
+    <arlequin.solvers.rows.EqualityRows.subtract_at_cols>` calls it with its own, valid by
+    construction."""
     for j in range(cols.size):
         c = cols[j]
         v[c] = v[c] - scale[j] * x[j]
@@ -110,14 +116,3 @@ def sum_of_squares(x: np.ndarray) -> float:
         with np.errstate(over="ignore", invalid="ignore"):
             return float(np.dot(x, x))
     return float(_sum_of_squares(x))
-
-
-def subtract_scaled_at(v: np.ndarray, cols: np.ndarray, scale: np.ndarray, x: np.ndarray) -> None:
-    """``v[cols] -= scale * x`` in place for distinct indices ``cols`` (k,) and ``scale``, ``x``
-    (k,): the bits of the numpy line (each entry's product, then its subtraction) in one pass,
-    without its gather, temporary and scatter (the equality rows' impulse, every step)."""
-    if not (_compiled(v) and _compiled(scale, x) and cols.shape == x.shape and cols.ndim == 1
-            and cols.dtype.kind in "iu"):  # fmt: skip
-        v[cols] -= scale * x
-        return
-    _subtract_scaled_at(v, cols, scale, x)

@@ -152,10 +152,10 @@ def min_scaled_cell_size(p, cells, dofs, u, ratio):
         area = 0.5 * abs((x[0, 2] - x[0, 0]) * (x[1, 3] - x[1, 1])
                          - (x[0, 3] - x[0, 1]) * (x[1, 2] - x[1, 0]))  # fmt: skip
         h = ratio[e] * (area / math.sqrt(longest2))
-        if h < best or h != h:  # a NaN (a collapsed cell: 0/0) kept, as np.min keeps it
+        if h != h:  # NaN: a cell collapsed to a point (0/0), returned as np.min returns it
+            return h
+        if h < best:
             best = h
-            if h != h:
-                return h
     return best
 
 

@@ -251,7 +251,7 @@ def solid_j2_kernel(
                 # linear hardening: Δγ of _plastic_multiplier's first line (equal to rounding:
                 # here the kernel's fastmath may fuse its products), here rather than through
                 # its call (not inlined: the point's live values spilled around it, 7% of the
-                # kernel on one core at nr = 30); H ≥ 0, so Δγ > 0
+                # planar kernel on one core at nr = 30); H ≥ 0, so Δγ > 0
                 dg = fy / (2.0 * G + 2.0 / 3.0 * prm[1])
             elif fy > 0.0:
                 dg = _plastic_multiplier(norm, ep, code, prm, G, dt)
