@@ -106,3 +106,61 @@ def test_signed_block_sums_are_the_bincount_sums():
     for k in range(idx.size):
         expected[block[k]] -= f[shuffled][k] * x[idx[k]]
     assert np.array_equal(out, expected)
+
+
+@pytest.mark.parametrize("kinds", ["both", "coupling only", "others only"])
+def test_kind_block_powers_are_the_per_kind_products_and_sums(kinds):
+    # the equality rows' powers of both kinds for two vectors in one compiled pass: the bits of
+    # the code it replaced (each kind's Bᵀλ by CsrProduct, then signed_block_sums per vector)
+    from arlequin.solvers.block_sums import kind_block_powers, signed_block_sums, touched_index
+    from arlequin.solvers.csr import CsrProduct
+
+    rng = np.random.default_rng(12)
+    m, n, n_blocks = 60, 400, 3
+    b = sp.random(m, n, density=0.03, random_state=rng, format="csr")
+    cols = np.unique(b.indices)
+    b_cols = b[:, cols].tocsr()
+    coupling = {"both": rng.random(m) < 0.6, "coupling only": np.ones(m, bool),
+                "others only": np.zeros(m, bool)}[kinds]  # fmt: skip
+    block_of_dof = np.repeat(np.arange(n_blocks), -(-n // n_blocks))[:n]
+    lam, x1, x2 = rng.standard_normal(m), rng.standard_normal(n), rng.standard_normal(n)
+    idx, block = touched_index(cols, block_of_dof[cols])
+    expected = np.zeros((2, 2, n_blocks))
+    for kind, rows in enumerate((np.nonzero(coupling)[0], np.nonzero(~coupling)[0])):
+        if rows.size:
+            force = CsrProduct(b_cols[rows].T.tocsr())(lam[rows])
+            for i, x in enumerate((x1, x2)):
+                signed_block_sums(force, x, idx, block, expected[i, kind])
+    bt = b_cols.T.tocsr()
+    other = (~coupling).astype(np.uint8)
+    has = np.array([coupling.any(), (~coupling).any()], dtype=np.uint8)
+    out = np.zeros((2, 2, n_blocks))
+    kind_block_powers(bt.indptr.astype(np.int64), bt.indices.astype(np.uint32), bt.data, other,
+                      lam, x1, x2, 2, has, idx, block, out)  # fmt: skip
+    assert np.array_equal(out, expected)
+    one = np.zeros((1, 2, n_blocks))  # one vector: x2 not read
+    kind_block_powers(bt.indptr.astype(np.int64), bt.indices.astype(np.uint32), bt.data, other,
+                      lam, x1, x1, 1, has, idx, block, one)  # fmt: skip
+    assert np.array_equal(one[0], expected[0])
+
+
+def test_scattered_block_powers_are_the_bincount_force_and_sums():
+    # a few active rows' powers for two vectors in one compiled pass: the bits of
+    # np.bincount for the force Gᵀλ on the touched dofs, then signed_block_sums per vector
+    from arlequin.solvers.block_sums import scattered_block_powers, signed_block_sums, touched_index
+
+    rng = np.random.default_rng(13)
+    m, n, n_blocks = 9, 300, 4
+    g = sp.random(m, n, density=0.02, random_state=rng, format="csr")
+    lam, x1, x2 = rng.standard_normal(m), rng.standard_normal(n), rng.standard_normal(n)
+    cols, inv = np.unique(g.indices, return_inverse=True)
+    row_of = np.repeat(np.arange(m), np.diff(g.indptr))
+    block_of_dof = np.repeat(np.arange(n_blocks), n // n_blocks)
+    idx, block = touched_index(cols, block_of_dof[cols])
+    force = np.bincount(inv, g.data * lam[row_of], minlength=cols.size)
+    expected = np.zeros((2, n_blocks))
+    for i, x in enumerate((x1, x2)):
+        signed_block_sums(force, x, idx, block, expected[i])
+    out = np.zeros((2, n_blocks))
+    scattered_block_powers(g.data, lam, row_of, inv, cols.size, x1, x2, 2, idx, block, out)
+    assert np.array_equal(out, expected)

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-__all__ = ["signed_block_sums", "touched_index"]
+__all__ = ["kind_block_powers", "scattered_block_powers", "signed_block_sums", "touched_index"]
 
 
 @nb.njit(cache=True)
@@ -49,6 +49,86 @@ def signed_block_sums(values, x, idx, block, out):
         acc -= values[k] * x[idx[k]]
     if current >= 0:
         out[current] = acc
+
+
+@nb.njit(cache=True)
+def kind_block_powers(indptr, indices, data, other, lam, x1, x2, n_x, has, idx, block, out):
+    """The equality rows' block powers of two kinds of rows for one or two vectors, in one pass.
+
+    For each touched dof k (row k of Bᵀ), the forces of the coupling rows (``other[r]`` 0) and
+    of the others (1), ``f = Σ_p data[p] lam[r]`` over the row's entries in stored order from
+    zero (:func:`~arlequin.solvers.csr.csr_times` on each kind's Bᵀ alone), then
+    ``out[i, kind, block[k]] -= f * x_i[idx[k]]`` for i < n_x: the floats of
+    :class:`~arlequin.solvers.csr.CsrProduct` per kind and :func:`signed_block_sums` per kind
+    and vector, bit for bit.
+
+    Parameters
+    ----------
+    indptr, indices, data : ndarray
+        Bᵀ (n_touched, m) in CSR form, each row's entries by increasing row r of B.
+    other : ndarray of uint8, shape (m,)
+        1 for the rows that are not coupling rows.
+    lam : ndarray, shape (m,)
+        The rows' multipliers.
+    x1, x2 : ndarray, shape (n,)
+        The vectors (x2 read only when n_x is 2).
+    has : ndarray of uint8, shape (2,)
+        Whether each kind has rows: an absent kind's powers stay zero.
+    idx, block : ndarray of uint32, shape (n_touched,)
+        :func:`touched_index`.
+    out : ndarray, shape (n_x, 2, n_blocks)
+        Accumulated into (W).
+    """
+    for k in range(idx.size):
+        fc = 0.0
+        fo = 0.0
+        for p in range(indptr[k], indptr[k + 1]):
+            r = indices[p]
+            if other[r]:
+                fo += data[p] * lam[r]
+            else:
+                fc += data[p] * lam[r]
+        b = block[k]
+        j = idx[k]
+        if has[0]:
+            out[0, 0, b] -= fc * x1[j]
+            if n_x == 2:
+                out[1, 0, b] -= fc * x2[j]
+        if has[1]:
+            out[0, 1, b] -= fo * x1[j]
+            if n_x == 2:
+                out[1, 1, b] -= fo * x2[j]
+
+
+@nb.njit(cache=True)
+def scattered_block_powers(data, lam, row_of, inv, n_touched, x1, x2, n_x, idx, block, out):
+    """Block powers of the force Gᵀλ of a few rows for one or two vectors, in one pass.
+
+    ``force[inv[p]] += data[p] * lam[row_of[p]]`` over the entries in order from zero (the
+    floats of ``np.bincount(inv, data * lam[row_of])``), then ``out[i, block[k]] -= force[k] *
+    x_i[idx[k]]`` (:func:`signed_block_sums`) for i < n_x, bit for bit.
+
+    Parameters
+    ----------
+    data : ndarray, shape (nnz,)
+        The rows' entries.
+    lam : ndarray, shape (m,)
+    row_of, inv : ndarray of int, shape (nnz,)
+        Each entry's row and its column among the n_touched touched dofs.
+    x1, x2 : ndarray, shape (n,)
+    idx, block : ndarray of uint32, shape (n_touched,)
+    out : ndarray, shape (n_x, n_blocks)
+        Accumulated into (W).
+    """
+    force = np.zeros(n_touched)
+    for p in range(data.size):
+        force[inv[p]] += data[p] * lam[row_of[p]]
+    for k in range(n_touched):
+        b = block[k]
+        j = idx[k]
+        out[0, b] -= force[k] * x1[j]
+        if n_x == 2:
+            out[1, b] -= force[k] * x2[j]
 
 
 def touched_index(dofs: np.ndarray, blocks: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -396,14 +396,11 @@ class CentralDifference(Integrator):
         vs = (v,) if v2 is None else (v, v2)
         nb = len(self.ops.blocks)
         out = np.zeros((len(vs), 4, nb))
-        if self.rows.m:
-            for i, (pc, po) in enumerate(self.rows.block_powers_of(self._lam_e / self._dt_bar, vs)):
-                out[i, 1] = pc
-                out[i, 2] = po
+        if self.rows.m:  # rows 1 and 2: the coupling rows' and the others'
+            self.rows.add_block_powers(self._lam_e / self._dt_bar, vs, out[:, 1:3])
         if self._g_a.shape[0]:
             lam = self._lam_a / self._dt_bar
-            for i, p in enumerate(unilateral_block_powers(self.ops, self._g_a, lam, vs)):
-                out[i, 2] += p
+            out[:, 2] += unilateral_block_powers(self.ops, self._g_a, lam, vs)
         tic = energy_products_start()
         for i, x in enumerate(vs):
             if self._f_ext is not None:

@@ -11,6 +11,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..contract import ConstraintError, same_pattern
+from .active_schur import ActiveSchur
 from .linalg import dense_cho_factor, dense_cho_solve, factor_checked, factor_rows
 
 __all__ = ["ImpulseSolver"]
@@ -127,26 +128,21 @@ class ImpulseSolver:
             lam_a = self._cached(key, build_aa, g_a).solve(r_a)
             return (self.solve_equality(r_e) if self.m_e else np.zeros(0)), lam_a
         if m_a <= self._DENSE_SCHUR:
-            e_rows, s_ae_e = self._shared_part(g_a)
+            e_rows, shared, bt = self._shared_part(g_a)
             if self._free[e_rows].all():
                 # the equality rows the active rows meet (a symmetry axis under the contact)
                 # are decoupled in S_EE (divisions): the Schur complement and the corrections
-                # on those rows alone, dense
-                d_e = self._free_diag[e_rows]
+                # on those rows alone, dense, built, factorised and solved compiled
+                # (active_schur: a deforming contact's rows are new at every step)
+                pat = self._pattern_of(g_a)
 
                 def build_decoupled():
-                    schur = _dense_gram(g_a, minv, self._pattern_of(g_a))
-                    if e_rows.size:
-                        schur -= (s_ae_e / d_e) @ s_ae_e.T
-                    return self._cholesky(schur, m_a)
+                    return ActiveSchur(g_a, minv, pat["pos"], pat["cols"].size, shared, e_rows,
+                                       bt, self._free_diag[e_rows])  # fmt: skip
 
-                cho = self._cached(key, build_decoupled, g_a)
+                factor = self._cached(key, build_decoupled, g_a)
                 y = self.lu.solve(r_e)
-                lam_a = dense_cho_solve(cho, r_a - s_ae_e @ y[e_rows]) if e_rows.size else \
-                    dense_cho_solve(cho, r_a)  # fmt: skip
-                if e_rows.size:
-                    y[e_rows] -= (s_ae_e.T @ lam_a) / d_e
-                return y, lam_a
+                return y, factor.solve(r_a, y)
         s_ae = self._s_ae(g_a)
         if m_a <= self._DENSE_SCHUR:
 
@@ -213,33 +209,28 @@ class ImpulseSolver:
         self._pattern = (g_a, arrays)
         return arrays
 
-    def _shared_part(self, g_a: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray]:
-        """(the equality rows e that share a dof with the active rows, S_AE[:, e] dense
-        (m_A, len(e))): G_A M⁻¹ on the shared dofs (a few) times those rows of Bᵀ."""
+    def _shared_part(self, g_a: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(the equality rows e that share a dof with the active rows, each entry's column among
+        those shared dofs or −1 (nnz,), Bᵀ on the shared dofs and the rows e dense
+        (n_shared, len(e))): arrays of the rows' pattern, kept with it."""
         pat = self._pattern_of(g_a)
-        m_a = g_a.shape[0]
         if "shared" not in pat:
-            shared = self._eq_mask[g_a.indices]
-            if shared.any():
-                idx = g_a.indices[shared]
-                sh, pos = np.unique(idx, return_inverse=True)
-                pat["shared"] = (shared, idx, sh, (pat["row"][shared], pos))
+            on_eq = self._eq_mask[g_a.indices]
+            shared = np.full(g_a.indices.size, -1, dtype=np.int64)
+            if on_eq.any():
+                sh, shared[on_eq] = np.unique(g_a.indices[on_eq], return_inverse=True)
             else:
-                pat["shared"] = None
-        if pat["shared"] is None:
-            return np.zeros(0, dtype=np.int64), np.zeros((m_a, 0))
-        shared, idx, sh, at = pat["shared"]
-        g = np.zeros((m_a, sh.size))
-        np.add.at(g, at, g_a.data[shared] * self.inv_mass[idx])
-        # Bᵀ's rows on those dofs, dense on the equality rows they touch: the same few (the
-        # axis under the contact) step after step
-        cached = self._eq_t_rows
-        if cached is None or not np.array_equal(cached[0], sh):
-            part = self._eq_t[sh].tocsc()
-            e_rows = np.nonzero(np.diff(part.indptr))[0]
-            cached = (sh, e_rows, part[:, e_rows].toarray())
-            self._eq_t_rows = cached
-        return cached[1], g @ cached[2]
+                sh = np.zeros(0, dtype=np.int64)
+            # Bᵀ's rows on those dofs, dense on the equality rows they touch: the same few
+            # (the axis under the contact) step after step
+            cached = self._eq_t_rows
+            if cached is None or not np.array_equal(cached[0], sh):
+                part = self._eq_t[sh].tocsc()
+                e_rows = np.nonzero(np.diff(part.indptr))[0]
+                cached = (sh, e_rows, np.ascontiguousarray(part[:, e_rows].toarray()))
+                self._eq_t_rows = cached
+            pat["shared"] = (cached[1], shared, cached[2])
+        return pat["shared"]
 
     def _s_ae(self, g_a: sp.csr_matrix) -> sp.csr_matrix:
         """S_AE = G_A M⁻¹ Bᵀ (m_A, m_E) from the entries of G_A on dofs the equality rows touch

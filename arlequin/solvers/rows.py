@@ -18,7 +18,7 @@ import scipy.sparse as sp
 
 from ..contract import csr_pattern, csr_with_data, same_pattern
 from ..problem.system import LinearConstraint
-from .block_sums import signed_block_sums, touched_index
+from .block_sums import kind_block_powers, scattered_block_powers, touched_index
 from .csr import CsrProduct, csr_times, subtract_scaled_transposed
 from .linalg import factor_checked
 from .operators import SystemOperators
@@ -201,9 +201,12 @@ def transposed_times(g: sp.csr_matrix, lam: np.ndarray) -> np.ndarray:
 def _compiled_rows(g: sp.csr_matrix, *vectors: np.ndarray) -> bool:
     """Whether the compiled row kernels take G and these vectors as they are (float64 values,
     contiguous float64 vectors of G's sizes)."""
-    return g.data.dtype == np.float64 and all(
-        x.dtype == np.float64 and x.ndim == 1 and x.flags.c_contiguous for x in vectors
-    )
+    if g.data.dtype != np.float64:
+        return False
+    for x in vectors:  # a loop, not all() of a generator (see vector_updates._compiled)
+        if not (x.dtype == np.float64 and x.ndim == 1 and x.flags.c_contiguous):
+            return False
+    return True
 
 
 def rows_times(g: sp.csr_matrix, x: np.ndarray) -> np.ndarray:
@@ -244,12 +247,18 @@ def unilateral_block_power(
 
 def unilateral_block_powers(
     ops: SystemOperators, g: sp.csr_matrix, lam: np.ndarray, xs: Sequence[np.ndarray]
-) -> list[np.ndarray]:
-    """:func:`unilateral_block_power` for several vectors x, on the dofs the rows touch only
-    (the same powers up to round-off: the force Gᵀλ is summed on those dofs alone)."""
+) -> np.ndarray:
+    """:func:`unilateral_block_power` for one or two vectors x (n,), shape (len(xs), n_blocks),
+    on the dofs the rows touch only (the same powers up to round-off: the force Gᵀλ is summed
+    on those dofs alone), in one compiled pass
+    (:func:`~arlequin.solvers.block_sums.scattered_block_powers`: the floats of
+    ``np.bincount`` for the force and :func:`signed_block_sums` for each vector)."""
     nb = len(ops.blocks)
+    if not 1 <= len(xs) <= 2:
+        raise ValueError(f"unilateral_block_powers: one or two vectors, got {len(xs)}")
+    out = np.zeros((len(xs), nb))
     if g.shape[0] == 0:
-        return [np.zeros(nb) for _ in xs]
+        return out
     # the touched dofs of the last rows (the same object while the active rows are: most
     # steps of a Taylor bar), as transposed() keeps its transpose, or of their pattern (the
     # same read-only index arrays: csr_pattern's, a deforming contact's new rows each step)
@@ -260,13 +269,15 @@ def unilateral_block_powers(
         index = touched_index(cols, ops.block_of_dof[cols])
         _TOUCHED[0], _TOUCHED[1] = g, (cols, inv, row_of, *index)
     cols, inv, row_of, idx, block = _TOUCHED[1]
+    x1 = np.ascontiguousarray(xs[0], dtype=float)
+    x2 = np.ascontiguousarray(xs[-1], dtype=float)
+    if x1.shape != (ops.n,) or x2.shape != (ops.n,):
+        raise ValueError(f"unilateral_block_powers: vectors of shape ({ops.n},), got "
+                         f"{[np.shape(x) for x in xs]}")  # fmt: skip
     tic = energy_products_start()
-    force = np.bincount(inv, g.data * lam[row_of], minlength=cols.size)
-    out = []
-    for x in xs:
-        p = np.zeros(nb)
-        signed_block_sums(force, x, idx, block, p)
-        out.append(p)
+    scattered_block_powers(np.ascontiguousarray(g.data, dtype=float),
+                           np.ascontiguousarray(lam, dtype=float), row_of, inv, cols.size, x1,
+                           x2, len(xs), idx, block, out)  # fmt: skip
     energy_products_done(tic)
     return out
 
@@ -345,7 +356,7 @@ class EqualityRows:
                 shape=(self.n_blocks * self.m, self.cols.size),
             )
         self._coupling_f = self.coupling.astype(float)
-        self._by_kind: list[tuple[np.ndarray, CsrProduct]] | None = None
+        self._by_kind: tuple[tuple[np.ndarray, ...], np.ndarray] | None = None
         self._constant = all(not callable(c.rhs) for c in self.constraints)
         self._g0 = self._g(0.0) if self._constant else None
 
@@ -401,7 +412,7 @@ class EqualityRows:
         (:func:`~arlequin.solvers.vector_updates.subtract_scaled_at`)."""
         k = self.cols.shape
         fast = (v.shape == (self.n,) and scale.shape == x.shape == k and v.flags.c_contiguous
-                and all(a.dtype == np.float64 for a in (v, scale, x)))  # fmt: skip
+                and v.dtype == scale.dtype == x.dtype == np.float64)  # fmt: skip
         if not fast:
             v[self.cols] -= scale * x
             return
@@ -412,33 +423,48 @@ class EqualityRows:
     ) -> list[tuple[np.ndarray, np.ndarray]]:
         """:meth:`block_powers` for several vectors x (on every dof, (n,)) with the same
         multipliers, from the forces: ``−Σ_{j∈b} x_j (B_cᵀλ_c)_j`` and the same with the other
-        rows. The forces are computed once (a kind of rows that is absent costs nothing), then
-        each x costs one compiled pass over the touched dofs
-        (:func:`~arlequin.solvers.block_sums.signed_block_sums`); the same powers as
+        rows (:meth:`add_block_powers`, two vectors at a time); the same powers as
         :meth:`block_powers` up to round-off (the order of the sums)."""
-        nb = self.n_blocks
+        out = np.zeros((len(vs), 2, self.n_blocks))
+        for i in range(0, len(vs), 2):
+            self.add_block_powers(lam, vs[i : i + 2], out[i : i + 2])
+        return [(o[0], o[1]) for o in out]
+
+    def add_block_powers(self, lam: np.ndarray, vs: Sequence[np.ndarray], out: np.ndarray) -> None:
+        """Accumulate into ``out`` (len(vs), 2, n_blocks) the powers ``−Σ_{j∈b} x_j
+        (B_cᵀλ_c)_j`` of the coupling rows (``out[i, 0]``) and of the others (``out[i, 1]``)
+        for one or two vectors x (n,) of ``vs``: one compiled pass over the touched dofs
+        (:func:`~arlequin.solvers.block_sums.kind_block_powers`; a zero ``out`` receives the
+        floats of each kind's Bᵀλ summed alone, then
+        :func:`~arlequin.solvers.block_sums.signed_block_sums` for each vector and kind)."""
+        if not 1 <= len(vs) <= 2 or out.shape != (len(vs), 2, self.n_blocks):
+            raise ValueError(f"add_block_powers: one or two vectors and out of shape "
+                             f"({len(vs)}, 2, {self.n_blocks}), got {out.shape}")  # fmt: skip
         if self.m == 0:
-            return [(np.zeros(nb), np.zeros(nb)) for _ in vs]
+            return
         if self._by_kind is None:
-            # Bᵀ of the coupling rows and of the others, apart (made on first use), and the
-            # touched dofs with their blocks for the compiled sums
-            kinds = (np.nonzero(self.coupling)[0], np.nonzero(~self.coupling)[0])
-            self._by_kind = [(r, CsrProduct(self.matrix_cols[r].T.tocsr())) for r in kinds]
+            # Bᵀ on the touched dofs (each row's entries by increasing row of B, as each kind's
+            # Bᵀ alone has them), the rows' kinds, and the touched dofs with their blocks
+            bt = self.matrix_cols.T.tocsr()
+            bt.sort_indices()
+            other = np.ascontiguousarray(~self.coupling, dtype=np.uint8)
+            has = np.array([other.size - other.sum() > 0, other.sum() > 0], dtype=np.uint8)
+            arrays = (np.ascontiguousarray(bt.indptr, dtype=np.int64),
+                      np.ascontiguousarray(bt.indices, dtype=np.uint32),
+                      np.ascontiguousarray(bt.data, dtype=float), other)  # fmt: skip
+            self._by_kind = (arrays, has)
             self._block_sums = touched_index(self.cols, self.block_of_col)
+        arrays, has = self._by_kind
         idx, block = self._block_sums
+        x1 = np.ascontiguousarray(vs[0], dtype=float)
+        x2 = np.ascontiguousarray(vs[-1], dtype=float)
+        if x1.shape != (self.n,) or x2.shape != (self.n,):
+            raise ValueError(f"add_block_powers: vectors of shape ({self.n},), got "
+                             f"{[np.shape(x) for x in vs]}")  # fmt: skip
         tic = energy_products_start()
-        forces = [bt_times(lam[r]) if r.size else None for r, bt_times in self._by_kind]
-        out = []
-        for x in vs:
-            pair = []
-            for f in forces:
-                p = np.zeros(nb)
-                if f is not None:
-                    signed_block_sums(f, x, idx, block, p)
-                pair.append(p)
-            out.append((pair[0], pair[1]))
+        kind_block_powers(*arrays, np.ascontiguousarray(lam, dtype=float), x1, x2, len(vs), has,
+                          idx, block, out)  # fmt: skip
         energy_products_done(tic)
-        return out
 
     def row_name(self, i: int) -> str:
         """Description of stacked row ``i`` for error messages."""

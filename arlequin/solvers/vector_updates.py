@@ -64,10 +64,11 @@ def subtract_scaled_at(v, cols, scale, x):
 def _compiled(*arrays: np.ndarray) -> bool:
     """Whether the compiled loops take these arrays: 1D contiguous float64 of one size."""
     n = arrays[0].shape
-    return all(
-        a.dtype == np.float64 and a.ndim == 1 and a.shape == n and a.flags.c_contiguous
-        for a in arrays
-    )
+    # a loop, not all() of a generator: its frame cost more than the tests (several calls a step)
+    for a in arrays:
+        if not (a.dtype == np.float64 and a.ndim == 1 and a.shape == n and a.flags.c_contiguous):
+            return False
+    return True
 
 
 def scaled_plus(alpha: float, x: np.ndarray, y: np.ndarray) -> np.ndarray:
