@@ -136,6 +136,13 @@ def test_sum_of_squares_of_the_finite_check():
         assert not np.isfinite(sum_of_squares(y))
     assert sum_of_squares(np.full(9, 1e200)) == np.inf  # each square 1e400: overflow
     assert sum_of_squares(np.zeros(0)) == 0.0
+    # u and v of the check in one call: the sum of the two (each in its own order)
+    z = rng.standard_normal(1_000)
+    assert sum_of_squares(x, z) == sum_of_squares(x) + sum_of_squares(z)
+    y = z.copy()
+    y[3] = np.nan
+    assert not np.isfinite(sum_of_squares(x, y))
+    assert sum_of_squares(x, z, z) == pytest.approx(float(x @ x + 2 * z @ z), rel=1e-13)
 
 
 def test_dense_active_rows_beside_unshared_equality_rows():
@@ -206,6 +213,10 @@ def test_timer_splits_the_steps_of_an_explicit_run(clock):
     # the energy bookkeeping's products (the coupling's powers here) are a part of the
     # linear algebra
     assert 0.0 < rep["energy_products_seconds"] <= rep["linear_algebra_seconds"]
+    # so are the step's compiled vector updates (the kick, the predictor, the check's Σx²)
+    assert 0.0 < rep["vector_updates_seconds"]
+    assert (rep["energy_products_seconds"] + rep["vector_updates_seconds"]
+            <= rep["linear_algebra_seconds"] * (1 + 1e-12))  # fmt: skip
     # the timers change nothing in the run
     assert np.array_equal(plain.contact_pressure, timed.contact_pressure)
     assert np.array_equal(plain.total_energy, timed.total_energy)

@@ -379,10 +379,7 @@ class Integrator:
             return
         step = self.step_count + 1 if step is None else int(step)
         # Σx²: NaN, ±inf and values whose energy would overflow all make it non-finite
-        check = 0.0
-        for x in arrays:
-            check += sum_of_squares(x)
-        if not math.isfinite(check):
+        if not math.isfinite(sum_of_squares(*arrays)):
             raise SimulationError(
                 f"{self.name}: non-finite displacement or velocity (NaN or overflow) at step "
                 f"{step}, t = {t_new:.6e} s (dt = {self.dt:.6e} s)",

@@ -52,7 +52,7 @@ from .registry import register
 from .row_basis import ImpulseBasis
 from .rows import EqualityRows, rows_times, subtract_transposed, unilateral_block_powers
 from .stability import DEFAULT_SAFETY, StableStep, check_time_step, stable_time_step
-from .timing import SWITCH, energy_products_done, energy_products_start
+from .timing import SWITCH, energy_products_done, energy_products_start, vector_updates_done
 from .vector_updates import interpolated, scaled_plus, work_products
 
 __all__ = ["DEFAULT_SAFETY", "CentralDifference"]
@@ -487,7 +487,9 @@ class CentralDifference(Integrator):
         u_new = scaled_plus(dt, v_half, self.u)  # u + Δt v^{n+½}, one compiled pass
         f_int, f_ext, trial = self._forces(u_new, t_new, dt)
         f_damp = self._damping_force(v_half)  # −C v^{n+1/2}: the damping force at t_{n+1}
+        tic = energy_products_start()  # M⁻¹ f, a diagonal solve: timed as a vector update
         a_new = self._acceleration(f_int if f_damp is None else f_int + f_damp, f_ext)
+        vector_updates_done(tic)
         # the step size at t is final now: commit the works of the step that ended at t
         self._w_ext, self._w_coupling, self._w_constraint = self._works()
         self._w_damping = self._damping_work()

@@ -221,8 +221,8 @@ class SystemOperators:
                 raise ValueError("internal_force: a tangent is assembled for every block")
             idx, k_rows, terms = self._rows_of(tuple(blocks))
             f = np.zeros(u.shape)
-            if k_rows.nnz:
-                f[idx] = k_rows @ u
+            if k_rows is not None:
+                f[idx] = k_rows(u)
         else:
             # the assembled (linear) part; nothing to multiply when every term is nonlinear
             f = self._stiffness_times(u) if self.stiffness.nnz else np.zeros(u.shape)
@@ -235,27 +235,27 @@ class SystemOperators:
         if tangent:
             self.check_tangents("a tangent of the coupled system")
         kt_blocks: dict[int, sp.csr_matrix] = {}
-        for bi, ti, term in terms:
-            b = self.blocks[bi]
-            ut = self._term_u(b, term, u)
-            state = states[b.name][ti]
+        for bi, ti, term, dofs, name, uses_dt in self._force_terms(terms):
+            ub = u[dofs]
+            p = term.transfer
+            ut = ub if p is None else p @ ub
+            state = states[name][ti]
             tic = timer.clock() if timer is not None else 0.0
-            if getattr(term.model, "uses_time_step", False):
+            if uses_dt:
                 ft, new_state = term.model.internal_force(ut, state, term.weight, dt=dt)
             else:
                 ft, new_state = term.model.internal_force(ut, state, term.weight)
             if timer is not None:
                 timer.kernel += timer.clock() - tic
-            trial[b.name][ti] = new_state
-            p = term.transfer
+            trial[name][ti] = new_state
             ft = ft if p is None else p.T @ ft
             # ±ft added or subtracted in place (a + (−b) is a − b: the same floats, no temporary)
             if term.sign == 1:
-                f[b.dofs] += ft
+                f[dofs] += ft
             elif term.sign == -1:
-                f[b.dofs] -= ft
+                f[dofs] -= ft
             else:
-                f[b.dofs] += term.sign * ft
+                f[dofs] += term.sign * ft
             if tangent:
                 if self.tangent_kind == "consistent":
                     if getattr(term.model, "uses_time_step", False):  # rates: the same dt
@@ -276,16 +276,34 @@ class SystemOperators:
             kt_full = (self.stiffness + sp.block_diag(blocks, format="csr")).tocsr()
         return f, trial, kt_full
 
+    def _force_terms(self, terms: list) -> list[tuple]:
+        """``terms`` (block index, term index, term) with their block's dofs (a slice), name
+        and whether the model takes the step (``uses_time_step``), kept for each of the
+        operators' own lists of terms (the blocks' properties cost a few µs a step)."""
+        cache = self.__dict__.setdefault("_force_terms_cache", {})
+        entry = cache.get(id(terms))
+        if entry is None or entry[0] is not terms:
+            found = [
+                (bi, ti, t, self.blocks[bi].dofs, self.blocks[bi].name,
+                 bool(getattr(t.model, "uses_time_step", False)))
+                for bi, ti, t in terms
+            ]  # fmt: skip
+            entry = cache[id(terms)] = (terms, found)  # the list kept: its id stays its own
+        return entry[1]
+
     def _rows_of(self, blocks: tuple[int, ...]):
-        """The dofs of ``blocks``, the rows of the linear stiffness on them and their
-        nonlinear terms (cached by the tuple of block indices)."""
+        """The dofs of ``blocks``, the product with the rows of the linear stiffness on them
+        (None if they are empty) and their nonlinear terms (cached by the tuple of block
+        indices)."""
         cache = self.__dict__.setdefault("_rows_cache", {})
         if blocks not in cache:
             idx = np.concatenate(
                 [np.arange(self.offsets[b], self.offsets[b + 1]) for b in sorted(set(blocks))]
             ) if blocks else np.zeros(0, dtype=np.int64)  # fmt: skip
             terms = [(bi, ti, t) for bi, ti, t in self._nonlinear_terms if bi in blocks]
-            cache[blocks] = (idx, self.stiffness[idx].tocsr(), terms)
+            rows = self.stiffness[idx].tocsr()
+            # compiled (CsrProduct: the floats of ``rows @ u``), None when nothing to multiply
+            cache[blocks] = (idx, CsrProduct(rows) if rows.nnz else None, terms)
         return cache[blocks]
 
     def _stiffness_times(self, u: np.ndarray) -> np.ndarray:

@@ -245,6 +245,21 @@ def unilateral_block_power(
     return -ops.block_dots(transposed(g) @ lam, x)
 
 
+def _vectors(xs: Sequence[np.ndarray], n: int, what: str) -> tuple[np.ndarray, np.ndarray]:
+    """The first and last of one or two vectors as contiguous float64 arrays (n,) (the arrays
+    themselves when they are: the common case, tested without a conversion call)."""
+    if not 1 <= len(xs) <= 2:
+        raise ValueError(f"{what}: one or two vectors, got {len(xs)}")
+    out = []
+    for x in (xs[0], xs[-1]):
+        if not (type(x) is np.ndarray and x.dtype == np.float64 and x.flags.c_contiguous):
+            x = np.ascontiguousarray(x, dtype=float)
+        if x.shape != (n,):
+            raise ValueError(f"{what}: vectors of shape ({n},), got {np.shape(x)}")
+        out.append(x)
+    return out[0], out[1]
+
+
 def unilateral_block_powers(
     ops: SystemOperators, g: sp.csr_matrix, lam: np.ndarray, xs: Sequence[np.ndarray]
 ) -> np.ndarray:
@@ -254,8 +269,7 @@ def unilateral_block_powers(
     (:func:`~arlequin.solvers.block_sums.scattered_block_powers`: the floats of
     ``np.bincount`` for the force and :func:`signed_block_sums` for each vector)."""
     nb = len(ops.blocks)
-    if not 1 <= len(xs) <= 2:
-        raise ValueError(f"unilateral_block_powers: one or two vectors, got {len(xs)}")
+    x1, x2 = _vectors(xs, ops.n, "unilateral_block_powers")
     out = np.zeros((len(xs), nb))
     if g.shape[0] == 0:
         return out
@@ -269,11 +283,6 @@ def unilateral_block_powers(
         index = touched_index(cols, ops.block_of_dof[cols])
         _TOUCHED[0], _TOUCHED[1] = g, (cols, inv, row_of, *index)
     cols, inv, row_of, idx, block = _TOUCHED[1]
-    x1 = np.ascontiguousarray(xs[0], dtype=float)
-    x2 = np.ascontiguousarray(xs[-1], dtype=float)
-    if x1.shape != (ops.n,) or x2.shape != (ops.n,):
-        raise ValueError(f"unilateral_block_powers: vectors of shape ({ops.n},), got "
-                         f"{[np.shape(x) for x in xs]}")  # fmt: skip
     tic = energy_products_start()
     scattered_block_powers(np.ascontiguousarray(g.data, dtype=float),
                            np.ascontiguousarray(lam, dtype=float), row_of, inv, cols.size, x1,
@@ -437,9 +446,10 @@ class EqualityRows:
         (:func:`~arlequin.solvers.block_sums.kind_block_powers`; a zero ``out`` receives the
         floats of each kind's Bᵀλ summed alone, then
         :func:`~arlequin.solvers.block_sums.signed_block_sums` for each vector and kind)."""
-        if not 1 <= len(vs) <= 2 or out.shape != (len(vs), 2, self.n_blocks):
-            raise ValueError(f"add_block_powers: one or two vectors and out of shape "
-                             f"({len(vs)}, 2, {self.n_blocks}), got {out.shape}")  # fmt: skip
+        x1, x2 = _vectors(vs, self.n, "add_block_powers")
+        if out.shape != (len(vs), 2, self.n_blocks):
+            raise ValueError(f"add_block_powers: out of shape ({len(vs)}, 2, {self.n_blocks}), "
+                             f"got {out.shape}")  # fmt: skip
         if self.m == 0:
             return
         if self._by_kind is None:
@@ -456,11 +466,6 @@ class EqualityRows:
             self._block_sums = touched_index(self.cols, self.block_of_col)
         arrays, has = self._by_kind
         idx, block = self._block_sums
-        x1 = np.ascontiguousarray(vs[0], dtype=float)
-        x2 = np.ascontiguousarray(vs[-1], dtype=float)
-        if x1.shape != (self.n,) or x2.shape != (self.n,):
-            raise ValueError(f"add_block_powers: vectors of shape ({self.n},), got "
-                             f"{[np.shape(x) for x in vs]}")  # fmt: skip
         tic = energy_products_start()
         kind_block_powers(*arrays, np.ascontiguousarray(lam, dtype=float), x1, x2, len(vs), has,
                           idx, block, out)  # fmt: skip

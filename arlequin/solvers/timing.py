@@ -15,7 +15,10 @@ What is timed, with ``time.perf_counter`` (or the thread's CPU time, ``clock="th
   factorised impulse solves and the dense Schur products of contact, and the products and
   per-block sums of the energy bookkeeping (the powers of the constraint forces Bᵀλ·v and
   Gᵀλ·v, of the external, friction and damping forces, and the internal work's Δu·f̄), also
-  counted apart in ``energy_products``;
+  counted apart in ``energy_products``; and the explicit step's compiled full-length vector
+  updates (the kick v⁻ + Δt̄ a, the predictor u + Δt v, the velocity at t, the finite-state
+  check's Σx², :mod:`arlequin.solvers.vector_updates`) and its diagonal solve M⁻¹ f, dense
+  linear algebra of one pass each, also counted apart in ``vector_updates``;
 * ``step``: :meth:`Integrator.step <arlequin.solvers.base.Integrator.step>` as a whole, so
   ``other = step − kernel − linear_algebra`` is the Python layer around them (the overhead).
 """
@@ -24,7 +27,14 @@ from __future__ import annotations
 
 from time import perf_counter, thread_time
 
-__all__ = ["CLOCKS", "SWITCH", "StepTimer", "energy_products_done", "energy_products_start"]
+__all__ = [
+    "CLOCKS",
+    "SWITCH",
+    "StepTimer",
+    "energy_products_done",
+    "energy_products_start",
+    "vector_updates_done",
+]
 
 #: The clocks of the timers: the wall clock, or the CPU time of the calling thread (on a
 #: machine shared with other jobs, the time the step's own Python layer uses, without the
@@ -56,6 +66,9 @@ class StepTimer:
         whole steps (the first two included).
     energy_products : float
         The part of ``linear_algebra`` in the energy bookkeeping's products and sums.
+    vector_updates : float
+        The part of ``linear_algebra`` in the step's compiled vector updates and its diagonal
+        solve (module docstring).
     steps : int
         Steps timed.
     first_step : float
@@ -77,6 +90,7 @@ class StepTimer:
         self.kernel = 0.0
         self.linear_algebra = 0.0
         self.energy_products = 0.0
+        self.vector_updates = 0.0
         self.step = 0.0
         self.steps = 0
         self.first_step = 0.0
@@ -92,7 +106,8 @@ class StepTimer:
         if self.skip_first and not self._started:
             self._started = True
             self.first_step = seconds
-            self.kernel = self.linear_algebra = self.energy_products = 0.0
+            self.kernel = self.linear_algebra = 0.0
+            self.energy_products = self.vector_updates = 0.0
             return
         self.step += seconds
         self.steps += 1
@@ -119,6 +134,7 @@ class StepTimer:
             "kernel_seconds": self.kernel,
             "linear_algebra_seconds": self.linear_algebra,
             "energy_products_seconds": self.energy_products,
+            "vector_updates_seconds": self.vector_updates,
             "other_seconds": self.other,
             "overhead_share": self.other / step if step > 0 else 0.0,
             "steps_per_second": self.steps / step if step > 0 else 0.0,
@@ -126,7 +142,8 @@ class StepTimer:
 
 
 def energy_products_start() -> float:
-    """The clock of the timer switched on (0.0 when off), before an energy product."""
+    """The clock of the timer switched on (0.0 when off), before an energy product or a vector
+    update."""
     timer = SWITCH.timer
     return timer.clock() if timer is not None else 0.0
 
@@ -139,3 +156,14 @@ def energy_products_done(tic: float) -> None:
         seconds = timer.clock() - tic
         timer.linear_algebra += seconds
         timer.energy_products += seconds
+
+
+def vector_updates_done(tic: float) -> None:
+    """Count the time since ``tic`` (:func:`energy_products_start`) as linear algebra
+    of the step's vector updates (nothing when the timers are off). For calls outside the other
+    timed regions only (no time counted twice)."""
+    timer = SWITCH.timer
+    if timer is not None:
+        seconds = timer.clock() - tic
+        timer.linear_algebra += seconds
+        timer.vector_updates += seconds

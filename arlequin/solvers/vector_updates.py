@@ -9,6 +9,11 @@ is one compiled loop over the same values with the same operations in the same o
 default: no fused multiply-add), so the results are those of the numpy lines bit for bit
 (tested against them).
 
+The kick, the predictor, the velocity at t and the finite-state check are timed as linear
+algebra by the step timers (:func:`~arlequin.solvers.timing.vector_updates_done`: they run
+outside the step's other timed regions); the internal work's products are timed with the energy
+bookkeeping by their caller.
+
 numba compiles on first call (cached on disk, ``cache=True``).
 """
 
@@ -16,6 +21,8 @@ from __future__ import annotations
 
 import numba as nb
 import numpy as np
+
+from .timing import energy_products_start, vector_updates_done
 
 __all__ = ["interpolated", "scaled_plus", "subtract_scaled_at", "sum_of_squares", "work_products"]
 
@@ -48,6 +55,11 @@ def _sum_of_squares(x):
     return total
 
 
+@nb.njit(cache=True, fastmath={"reassoc", "contract"})
+def _sum_of_squares_2(x, y):
+    return _sum_of_squares(x) + _sum_of_squares(y)
+
+
 @nb.njit(cache=True)
 def subtract_scaled_at(v, cols, scale, x):
     """``v[cols] -= scale * x`` in place (v float64 (n,), distinct indices ``cols`` (k,),
@@ -73,26 +85,30 @@ def _compiled(*arrays: np.ndarray) -> bool:
 
 def scaled_plus(alpha: float, x: np.ndarray, y: np.ndarray) -> np.ndarray:
     """``alpha x + y``, a new array (n,): the bits of ``z = alpha * x; z += y``."""
+    tic = energy_products_start()
     if not _compiled(x, y):
         z = alpha * x
         z += y
-        return z
-    out = np.empty(x.shape)
-    _scaled_plus(float(alpha), x, y, out)
-    return out
+    else:
+        z = np.empty(x.shape)
+        _scaled_plus(float(alpha), x, y, z)
+    vector_updates_done(tic)
+    return z
 
 
 def interpolated(x0: np.ndarray, x1: np.ndarray, share: float) -> np.ndarray:
     """``x0 + share (x1 − x0)``, a new array (n,): the bits of ``z = x1 − x0; z *= share;
     z += x0``."""
+    tic = energy_products_start()
     if not _compiled(x0, x1):
         z = x1 - x0
         z *= share
         z += x0
-        return z
-    out = np.empty(x0.shape)
-    _interpolated(x0, x1, float(share), out)
-    return out
+    else:
+        z = np.empty(x0.shape)
+        _interpolated(x0, x1, float(share), z)
+    vector_updates_done(tic)
+    return z
 
 
 def work_products(u_new: np.ndarray, u_old: np.ndarray, f_old: np.ndarray, f_new: np.ndarray,
@@ -108,12 +124,22 @@ def work_products(u_new: np.ndarray, u_old: np.ndarray, f_old: np.ndarray, f_new
     return out
 
 
-def sum_of_squares(x: np.ndarray) -> float:
-    """Σ x_i² (a 1D float array), a non-finite float if x holds a NaN or ±inf or the sum
-    overflows: the test of the integrators' finite-state check. Compiled without numpy's
-    floating-point error state (whose context cost as much as the two products it guarded);
-    its sums run in another order than BLAS's dot, so the value differs by round-off."""
-    if not _compiled(x):
-        with np.errstate(over="ignore", invalid="ignore"):
-            return float(np.dot(x, x))
-    return float(_sum_of_squares(x))
+def sum_of_squares(*arrays: np.ndarray) -> float:
+    """Σ x_i² over the arrays (1D float arrays), a non-finite float if one holds a NaN or ±inf
+    or the sum overflows: the test of the integrators' finite-state check. Compiled without
+    numpy's floating-point error state (whose context cost as much as the two products it
+    guarded), one call for one or two arrays; its sums run in another order than BLAS's dot,
+    so the value differs by round-off."""
+    tic = energy_products_start()
+    if len(arrays) == 2 and _compiled(arrays[0]) and _compiled(arrays[1]):
+        total = float(_sum_of_squares_2(*arrays))
+    else:
+        total = 0.0
+        for x in arrays:
+            if _compiled(x):
+                total += float(_sum_of_squares(x))
+            else:
+                with np.errstate(over="ignore", invalid="ignore"):
+                    total += float(np.dot(x, x))
+    vector_updates_done(tic)
+    return total
