@@ -392,4 +392,6 @@ class SystemOperators:
 
     def strain_linear(self, u: np.ndarray) -> np.ndarray:
         """½ uᵀ K u per block (J) for the linear blocks (0 for the others)."""
-        return 0.5 * self.block_dots(u, self.stiffness @ u)
+        ku = self._stiffness_times(u) if u.dtype == np.float64 and u.ndim == 1 else \
+            self.stiffness @ u  # compiled for a vector of floats: scipy's floats  # fmt: skip
+        return 0.5 * self.block_dots(u, ku)
