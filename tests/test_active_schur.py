@@ -93,3 +93,41 @@ def test_non_finite_rows_are_refused_and_a_nan_rhs_gives_nan():
     g.data[0] = np.inf
     with pytest.raises(ConstraintError, match="not finite"):
         ActiveSchur(g, np.ones(g.shape[1]), pos, cols.size)
+
+
+def test_duplicate_entries_are_summed():
+    # a row with two entries on one dof is the row with their sum (the exact matrix)
+    g = _rows(7)
+    cols, pos = _pattern(g)
+    ref = ActiveSchur(g, np.ones(g.shape[1]), pos, cols.size)
+    i, j = g.indptr[2], g.indptr[2] + 1
+    half = g.data[i] / 2.0
+    dup = sp.csr_matrix(
+        (np.insert(g.data, i, half), np.insert(g.indices, i, g.indices[i]),
+         np.concatenate([g.indptr[:3], g.indptr[3:] + 1])), shape=g.shape,
+    )  # fmt: skip
+    dup.data[j] = half  # the original entry split in two halves
+    cols_d, pos_d = np.unique(dup.indices, return_inverse=True)
+    got = ActiveSchur(dup, np.ones(g.shape[1]), pos_d, cols_d.size)
+    np.testing.assert_allclose(got.u, ref.u, rtol=1e-14, atol=1e-15)
+
+
+def test_sizes_and_diagonal_are_checked():
+    rng = np.random.default_rng(8)
+    g = _rows(9)
+    n = g.shape[1]
+    on_eq = np.zeros(n, dtype=bool)
+    on_eq[np.unique(g.indices)[:2]] = True
+    cols, pos = _pattern(g)
+    sh, shared = _shared(g, on_eq)
+    bt = np.eye(2)[: sh.size]
+    fac = ActiveSchur(g, np.ones(n), pos, cols.size, shared, np.array([3, 5]), bt, np.ones(2))
+    with pytest.raises(ValueError, match="r_a must have shape"):
+        fac.solve(np.ones(g.shape[0] + 1), np.zeros(6))
+    with pytest.raises(ValueError, match="y must be a float vector"):
+        fac.solve(np.ones(g.shape[0]))  # the equality rows' impulses are needed
+    with pytest.raises(ValueError, match="y must be a float vector"):
+        fac.solve(np.ones(g.shape[0]), np.zeros(5))  # row 5 outside
+    assert np.isfinite(fac.solve(rng.standard_normal(g.shape[0]), np.zeros(6))).all()
+    with pytest.raises(ConstraintError, match="non-positive or non-finite diagonal"):
+        ActiveSchur(g, np.ones(n), pos, cols.size, shared, np.array([3, 5]), bt, np.zeros(2))

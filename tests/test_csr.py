@@ -164,3 +164,22 @@ def test_scattered_block_powers_are_the_bincount_force_and_sums():
     out = np.zeros((2, n_blocks))
     scattered_block_powers(g.data, lam, row_of, inv, cols.size, x1, x2, 2, idx, block, out)
     assert np.array_equal(out, expected)
+
+
+def test_csr_times_subtract_scaled_is_the_product_then_the_update():
+    # the equality rows' impulse v[cols] −= M⁻¹ Bᵀλ in one compiled pass: the bits of the
+    # product's vector (CsrProduct, scipy's floats) and then the indexed update
+    from arlequin.solvers.csr import csr_times_subtract_scaled
+
+    rng = np.random.default_rng(14)
+    n, m = 300, 40
+    bt = sp.random(120, m, density=0.08, random_state=rng, format="csr")
+    cols = np.sort(rng.choice(n, 120, replace=False))
+    scale, lam, v = rng.uniform(0.5, 2.0, 120), rng.standard_normal(m), rng.standard_normal(n)
+    expected = v.copy()
+    expected[cols] -= scale * (bt @ lam)
+    product = CsrProduct(bt)
+    got = v.copy()
+    csr_times_subtract_scaled(product._indptr, product._indices, product._data, lam, cols,
+                              scale, got)  # fmt: skip
+    assert got.tobytes() == expected.tobytes()

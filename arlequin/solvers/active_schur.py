@@ -78,8 +78,8 @@ def _factor_active(indptr, indices, data, pos, n_cols, minv, shared, n_shared, b
     a = np.zeros((m, m))
     row_i = np.zeros(n_cols)  # row i of G_A M⁻¹, scattered on the columns
     for i in range(m):
-        for p in range(indptr[i], indptr[i + 1]):
-            row_i[pos[p]] = data[p] * minv[indices[p]]
+        for p in range(indptr[i], indptr[i + 1]):  # += : duplicate entries are summed
+            row_i[pos[p]] += data[p] * minv[indices[p]]
         for j in range(i + 1):
             s = 0.0
             for p in range(indptr[j], indptr[j + 1]):
@@ -172,6 +172,14 @@ class ActiveSchur:
             e_rows, bt, d_e = np.zeros(0, np.int64), np.zeros((0, 0)), np.zeros(0)
         self.e_rows = np.ascontiguousarray(e_rows, dtype=np.int64)
         self.d_e = np.ascontiguousarray(d_e, dtype=float)
+        if self.d_e.shape != self.e_rows.shape or bt.shape != (bt.shape[0], self.e_rows.size):
+            raise ValueError(f"ActiveSchur: d_e {self.d_e.shape} and Bᵀ {bt.shape} must match "
+                             f"the {self.e_rows.size} equality rows")  # fmt: skip
+        if not (self.d_e > 0.0).all():  # also refuses NaN: the complement divides by them
+            raise ConstraintError(
+                f"the equality rows met by the {m} active rows have a non-positive or "
+                f"non-finite diagonal entry of B M⁻¹ Bᵀ: {self.d_e.min()}"
+            )
         self.u = np.empty((m, m))
         self.s_ae = np.zeros((m, self.e_rows.size))
         code = _factor_active(
@@ -192,9 +200,19 @@ class ActiveSchur:
         (m_E,) solved without the active rows, corrected in place on ``e_rows``; a
         non-finite right-hand side gives non-finite impulses (the integrator's finite-state
         check then fails the step)."""
-        lam = np.empty(self.u.shape[0])
-        if y is None:
+        m = self.u.shape[0]
+        r_a = np.ascontiguousarray(r_a, dtype=float)
+        if r_a.shape != (m,):
+            raise ValueError(f"ActiveSchur.solve: r_a must have shape ({m},), got {r_a.shape}")
+        if self.e_rows.size:
+            # the compiled loop reads and writes y[e_rows] unchecked
+            if not (isinstance(y, np.ndarray) and y.dtype == np.float64 and y.ndim == 1
+                    and y.size > self.e_rows.max()):  # fmt: skip
+                raise ValueError(f"ActiveSchur.solve: y must be a float vector holding the "
+                                 f"equality rows up to {self.e_rows.max()}, got "
+                                 f"{np.shape(y)}")  # fmt: skip
+        else:
             y = np.zeros(0)
-        _solve_active(self.u, self.s_ae, self.d_e, self.e_rows,
-                      np.ascontiguousarray(r_a, dtype=float), y, lam)  # fmt: skip
+        lam = np.empty(m)
+        _solve_active(self.u, self.s_ae, self.d_e, self.e_rows, r_a, y, lam)
         return lam

@@ -350,12 +350,14 @@ class Integrator:
                 f"{self.name}: finished at t = {self.t:.6e} s, the last stop time "
                 "(set_stops with later times to go on)"
             )
+        # the clock first: a new step size redoes the impulse at t (explicit), timed parts
+        # counted in the step they belong to
+        timer = SWITCH.timer
+        tic = timer.clock() if timer is not None else 0.0
         if dt is not None:
             self.set_step_size(dt)
         t_next = self.t + self.dt
         t_old, dt_step, err = self.t, self.dt, self._t_err
-        timer = SWITCH.timer
-        tic = timer.clock() if timer is not None else 0.0
         try:
             self._step_impl()
         except StateError as err:

@@ -24,6 +24,7 @@ __all__ = [
     "CsrProduct",
     "csr_times",
     "csr_times_gathered",
+    "csr_times_subtract_scaled",
     "subtract_scaled_transposed",
 ]
 
@@ -113,6 +114,21 @@ def subtract_scaled_transposed(indptr, indices, data, lam, scale, v, acc):
             # a column met again subtracts scale·0 = +0 (scale > 0: M⁻¹): v − (+0) = v
             v[j] -= acc[j] * scale[j]
             acc[j] = 0.0
+
+
+@nb.njit(cache=True)
+def csr_times_subtract_scaled(indptr, indices, data, x, cols, scale, v):
+    """``v[cols] −= scale ⊙ (A x)`` in place for A in CSR form (n_rows, ·), its rows' entries
+    ``cols`` (n_rows,) of v and ``scale`` (n_rows,): each row's products added in stored order
+    from zero (:func:`csr_times`), then the row's product with its scale subtracted, the floats
+    of ``y = A @ x; v[cols] -= scale * y`` without y. The indices are not checked (the caller's
+    own, valid by construction)."""
+    for i in range(indptr.size - 1):
+        s = 0.0
+        for k in range(indptr[i], indptr[i + 1]):
+            s += data[k] * x[indices[k]]
+        c = cols[i]
+        v[c] = v[c] - scale[i] * s
 
 
 @nb.njit(parallel=True, cache=True)

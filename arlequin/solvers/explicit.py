@@ -272,7 +272,7 @@ class CentralDifference(Integrator):
             lam_e = solver.solve_equality(r_e)
             v_new = v_star
             if rows.m:
-                rows.subtract_at_cols(v_new, self._minv_cols, rows.transpose_times(lam_e))
+                rows.subtract_impulse(v_new, self._minv_cols, lam_e)
             self.status_iterations = 0
             if timer is not None:
                 timer.linear_algebra += timer.clock() - tic
@@ -301,7 +301,7 @@ class CentralDifference(Integrator):
             lam_e, lam_a = solver.solve(r_e, g_a, r_a)
             v_new = v_star.copy()
             if rows.m:
-                rows.subtract_at_cols(v_new, self._minv_cols, rows.transpose_times(lam_e))
+                rows.subtract_impulse(v_new, self._minv_cols, lam_e)
             if g_a.shape[0]:
                 # M⁻¹ Gᵀλ subtracted on G_A's columns alone (no n-vector for a few rows)
                 scratch = self._columns_scratch

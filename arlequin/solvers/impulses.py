@@ -159,7 +159,8 @@ class ImpulseSolver:
 
             coupled, x, cho = self._cached(key, build_schur, g_a)
             y = self.lu.solve(r_e)
-            lam_a = dense_cho_solve(cho, r_a - s_ae @ y)
+            # a non-finite right-hand side gives NaN impulses, as on the other paths
+            lam_a = _DenseFactor(cho).solve(r_a - s_ae @ y)
             if coupled.size:
                 y = y - x @ lam_a[coupled]
             return y, lam_a

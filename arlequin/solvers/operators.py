@@ -258,7 +258,7 @@ class SystemOperators:
                 f[dofs] += term.sign * ft
             if tangent:
                 if self.tangent_kind == "consistent":
-                    if getattr(term.model, "uses_time_step", False):  # rates: the same dt
+                    if uses_dt:  # rates: the same dt
                         kt = term.model.tangent(ut, state, term.weight, dt=dt)
                     else:
                         kt = term.model.tangent(ut, state, term.weight)

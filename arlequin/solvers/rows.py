@@ -19,7 +19,13 @@ import scipy.sparse as sp
 from ..contract import csr_pattern, csr_with_data, same_pattern
 from ..problem.system import LinearConstraint
 from .block_sums import kind_block_powers, scattered_block_powers, touched_index
-from .csr import CsrProduct, csr_times, subtract_scaled_transposed
+from .csr import (
+    PARALLEL_MIN_NNZ,
+    CsrProduct,
+    csr_times,
+    csr_times_subtract_scaled,
+    subtract_scaled_transposed,
+)
 from .linalg import factor_checked
 from .operators import SystemOperators
 from .timing import energy_products_done, energy_products_start
@@ -439,6 +445,21 @@ class EqualityRows:
             self.add_block_powers(lam, vs[i : i + 2], out[i : i + 2])
         return [(o[0], o[1]) for o in out]
 
+    def subtract_impulse(self, v: np.ndarray, scale: np.ndarray, lam: np.ndarray) -> None:
+        """``v[self.cols] −= scale ⊙ (Bᵀλ)`` in place (v (n,), scale on the touched dofs, λ
+        (m,)): the equality rows' impulse M⁻¹ Bᵀλ, one compiled pass
+        (:func:`~arlequin.solvers.csr.csr_times_subtract_scaled`), the floats of
+        ``subtract_at_cols(v, scale, transpose_times(lam))`` without the product's vector."""
+        a = self.transpose_times
+        fast = (a.nnz < PARALLEL_MIN_NNZ and v.shape == (self.n,) and v.flags.c_contiguous
+                and scale.shape == self.cols.shape and lam.shape == (self.m,)
+                and v.dtype == scale.dtype == lam.dtype == np.float64
+                and scale.flags.c_contiguous and lam.flags.c_contiguous)  # fmt: skip
+        if not fast:
+            self.subtract_at_cols(v, scale, a(lam))
+            return
+        csr_times_subtract_scaled(a._indptr, a._indices, a._data, lam, self.cols, scale, v)
+
     def add_block_powers(self, lam: np.ndarray, vs: Sequence[np.ndarray], out: np.ndarray) -> None:
         """Accumulate into ``out`` (len(vs), 2, n_blocks) the powers ``−Σ_{j∈b} x_j
         (B_cᵀλ_c)_j`` of the coupling rows (``out[i, 0]``) and of the others (``out[i, 1]``)
@@ -455,8 +476,9 @@ class EqualityRows:
         if self._by_kind is None:
             # Bᵀ on the touched dofs (each row's entries by increasing row of B, as each kind's
             # Bᵀ alone has them), the rows' kinds, and the touched dofs with their blocks
-            bt = self.matrix_cols.T.tocsr()
-            bt.sort_indices()
+            bt = self.matrix_cols_t  # its rows' entries by increasing row of B (CSC → CSR)
+            if not bt.has_sorted_indices:
+                bt = bt.sorted_indices()
             other = np.ascontiguousarray(~self.coupling, dtype=np.uint8)
             has = np.array([other.size - other.sum() > 0, other.sum() > 0], dtype=np.uint8)
             arrays = (np.ascontiguousarray(bt.indptr, dtype=np.int64),
