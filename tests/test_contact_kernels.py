@@ -24,8 +24,8 @@ from arlequin.models.contact.kernel import (
     level_set_begin,
     level_set_status,
     plane_gaps,
+    rows_sum_dot,
     rows_times,
-    rows_times_sum,
     scaled_entries,
 )
 from arlequin.models.contact.records import ContactTrial, build, evolve
@@ -59,7 +59,16 @@ def test_rows_products_equal_scipy_bit_for_bit(seed):
     x, z = rng.standard_normal((2, g.shape[1]))
     x[:5] = -0.0
     assert same_bytes(rows_times(g.indptr, g.indices, g.data, x), g @ x)
-    assert same_bytes(rows_times_sum(g.indptr, g.indices, g.data, x, z), g @ (x + z))
+    # the work's w · G (x + z): scipy's row products, then summed in order (a plain loop; BLAS's
+    # dot may pair the terms, so it is compared to round-off)
+    w = rng.standard_normal(g.shape[0])
+    rows = g @ (x + z)
+    total = 0.0
+    for wi, ri in zip(w, rows):
+        total += wi * ri
+    got = rows_sum_dot(g.indptr, g.indices, g.data, x, z, w)
+    assert same_bytes(np.float64(got), np.float64(total))
+    assert got == pytest.approx(float(w @ rows), rel=1e-13, abs=1e-300)
 
 
 @pytest.mark.parametrize("seed", range(4))

@@ -256,14 +256,16 @@ def _vectors(xs: Sequence[np.ndarray], n: int, what: str) -> tuple[np.ndarray, n
     themselves when they are: the common case, tested without a conversion call)."""
     if not 1 <= len(xs) <= 2:
         raise ValueError(f"{what}: one or two vectors, got {len(xs)}")
-    out = []
-    for x in (xs[0], xs[-1]):
-        if not (type(x) is np.ndarray and x.dtype == np.float64 and x.flags.c_contiguous):
-            x = np.ascontiguousarray(x, dtype=float)
-        if x.shape != (n,):
-            raise ValueError(f"{what}: vectors of shape ({n},), got {np.shape(x)}")
-        out.append(x)
-    return out[0], out[1]
+    x1, x2 = xs[0], xs[-1]
+    ok = (n,)
+    if (type(x1) is np.ndarray and type(x2) is np.ndarray and x1.shape == ok and x2.shape == ok
+            and x1.dtype == x2.dtype == np.float64 and x1.flags.c_contiguous
+            and x2.flags.c_contiguous):  # fmt: skip
+        return x1, x2  # the integrators' own vectors: no conversion
+    x1, x2 = np.ascontiguousarray(x1, dtype=float), np.ascontiguousarray(x2, dtype=float)
+    if x1.shape != ok or x2.shape != ok:
+        raise ValueError(f"{what}: vectors of shape ({n},), got {x1.shape} and {x2.shape}")
+    return x1, x2
 
 
 def unilateral_block_powers(

@@ -96,7 +96,7 @@ from .kernel import (
     equal_gathered,
     level_set_begin,
     level_set_status,
-    rows_times_sum,
+    rows_sum_dot,
     scaled_entries,
 )
 from .obstacles import LevelSetObstacle, Obstacle, PlaneObstacle, SphereObstacle
@@ -363,11 +363,13 @@ class _ContactConstraint:
         # B (v_before + v_after) with the sum on B's columns only (a full-size sum was most of
         # a commit); _make_b's rows are always CSR
         b = trial.matrix
-        if _compiled(b, v_before, self._csr_b) and v_after.shape == v_before.shape:
-            b_vsum = rows_times_sum(b.indptr, b.indices, b.data, v_before, v_after)
+        imp = np.asarray(impulse, dtype=float)
+        if (_compiled(b, v_before, self._csr_b) and v_after.shape == v_before.shape
+                and v_after.dtype == np.float64 and imp.shape == (b.shape[0],)):  # fmt: skip
+            work = state.work - 0.5 * rows_sum_dot(b.indptr, b.indices, b.data, v_before,
+                                                   v_after, imp)  # fmt: skip
         else:  # the kernel's reference
-            b_vsum = b @ (v_before + v_after)
-        work = state.work - 0.5 * float(np.asarray(impulse) @ b_vsum)
+            work = state.work - 0.5 * float(imp @ (b @ (v_before + v_after)))
         # the explicit scheme commits at the configuration its step started from: reuse it
         same = trial.u_start is u or np.array_equal(trial.u_start, u)
         geo_end = trial.geometry if same else self.geometry(u)
@@ -377,7 +379,7 @@ class _ContactConstraint:
             gap_start=trial.gap_start, vn_start=trial.vn_start, vn=trial.vn, lam=trial.lam,
             work=work, dt=trial.dt,
         )  # fmt: skip
-        total = np.asarray(impulse, dtype=float)
+        total = imp
         if state.impulse is not None:
             total = state.impulse + total
         # the trial's arrays are the constraint's own (update_status copied the multipliers),
