@@ -14,10 +14,11 @@ the factorisation and its tests), 100–150 µs a step of the ball impact, more 
 arithmetic of a dozen rows; here it is one compiled call, and the solve another.
 
 The floats differ from LAPACK's by round-off only (the order of the sums). The tests of
-positive definiteness are :meth:`ImpulseSolver._cholesky
-<arlequin.solvers.impulses.ImpulseSolver._cholesky>`'s: a non-finite entry, a non-positive
-pivot, or a pivot U_jj² below 1e-14 |S_jj| (a row dependent on the others to round-off) is
-refused.
+positive definiteness (:func:`cholesky_checked`, also the factorisation of
+:class:`~arlequin.solvers.impulses.ImpulseSolver`'s other dense paths): a non-finite entry, a
+non-positive pivot, or a pivot U_jj² below 1e-14 |S_jj| (a row dependent on the others to
+round-off; :class:`~arlequin.solvers.linalg.ScaledLU` applies 1e-14 to its pivots after a
+diagonal scaling) is refused.
 
 numba compiles on first call (cached on disk, ``cache=True``).
 """
@@ -29,7 +30,7 @@ import numpy as np
 
 from ..contract import ConstraintError
 
-__all__ = ["FACTOR_DEPENDENT", "FACTOR_NOT_FINITE", "FACTOR_OK", "ActiveSchur"]
+__all__ = ["FACTOR_DEPENDENT", "FACTOR_NOT_FINITE", "FACTOR_OK", "ActiveSchur", "cholesky_checked"]
 
 #: Status codes of the compiled factorisation (:class:`ActiveSchur` raises on the last two).
 FACTOR_OK, FACTOR_NOT_FINITE, FACTOR_DEPENDENT = 0, 1, 2
@@ -137,6 +138,33 @@ def _solve_active(u, s_ae, d_e, e_rows, r_a, y, lam):
         y[e_rows[e]] -= s / d_e[e]
 
 
+def _raise_for(code: int, m: int) -> None:
+    """The :class:`ConstraintError` of a factorisation's status code (nothing for
+    :data:`FACTOR_OK`), for the impulse matrix of ``m`` active rows."""
+    if code == FACTOR_NOT_FINITE:
+        raise ConstraintError(f"the impulse matrix of the {m} active rows is not finite")
+    if code == FACTOR_DEPENDENT:
+        raise ConstraintError(
+            "active unilateral rows are dependent on each other or on the equality rows "
+            f"({m} active rows)"
+        )
+
+
+def cholesky_checked(a: np.ndarray) -> np.ndarray:
+    """Upper Cholesky factor U (m, m) of a dense symmetric matrix a (UᵀU = a, strict lower
+    part zero), compiled, with the tests of the module docstring.
+
+    Raises
+    ------
+    ConstraintError
+        If ``a`` is not finite or not positive definite, or a row depends on the others.
+    """
+    a = np.ascontiguousarray(a, dtype=float)
+    u = np.empty(a.shape)
+    _raise_for(_cholesky_upper(a, u), a.shape[0])
+    return u
+
+
 class ActiveSchur:
     """The factorised impulse matrix of the active rows (module docstring), with a ``solve``.
 
@@ -187,13 +215,7 @@ class ActiveSchur:
             int(n_cols), inv_mass, shared, int(bt.shape[0]), np.ascontiguousarray(bt, dtype=float),
             self.d_e, self.u, self.s_ae,
         )  # fmt: skip
-        if code == FACTOR_NOT_FINITE:
-            raise ConstraintError(f"the impulse matrix of the {m} active rows is not finite")
-        if code == FACTOR_DEPENDENT:
-            raise ConstraintError(
-                "active unilateral rows are dependent on each other or on the equality rows "
-                f"({m} active rows)"
-            )
+        _raise_for(code, m)
 
     def solve(self, r_a: np.ndarray, y: np.ndarray | None = None) -> np.ndarray:
         """λ_A (m,) for the right-hand side r_a (m,) and the equality rows' impulses y

@@ -5,7 +5,11 @@ sums −Σ_{j∈b} f_j x_j of a force f on the dofs the rows touch. With numpy e
 a product, a segmented sum and a scatter of the blocks present: about sixteen calls a step,
 whose dispatch cost more than their arithmetic. :func:`signed_block_sums` makes each in one
 compiled pass (sums in the order of the touched dofs; numpy's segmented sums pair their terms,
-so the powers move by round-off).
+so the powers move by round-off). The explicit step now calls the fused kernels built on its
+arithmetic: :func:`kind_block_powers` (the equality rows' force of each kind and its sums for
+both velocities, one pass) and :func:`scattered_block_powers` (the active rows' Gᵀλ and its
+sums); :func:`signed_block_sums`, one force and one vector, is their reference (tested bit for
+bit against it).
 
 numba compiles on first call (cached on disk, ``cache=True``).
 """

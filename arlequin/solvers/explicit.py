@@ -52,7 +52,7 @@ from .registry import register
 from .row_basis import ImpulseBasis
 from .rows import EqualityRows, rows_times, subtract_transposed, unilateral_block_powers
 from .stability import DEFAULT_SAFETY, StableStep, check_time_step, stable_time_step
-from .timing import SWITCH, energy_products_done, energy_products_start, vector_updates_done
+from .timing import SWITCH, energy_products_done, timer_start, vector_updates_done
 from .vector_updates import interpolated, scaled_plus, work_products
 
 __all__ = ["DEFAULT_SAFETY", "CentralDifference"]
@@ -401,7 +401,7 @@ class CentralDifference(Integrator):
         if self._g_a.shape[0]:
             lam = self._lam_a / self._dt_bar
             out[:, 2] += unilateral_block_powers(self.ops, self._g_a, lam, vs)
-        tic = energy_products_start()
+        tic = timer_start()
         for i, x in enumerate(vs):
             if self._f_ext is not None:
                 out[i, 0] = self.ops.block_dots(self._f_ext, x)
@@ -487,7 +487,7 @@ class CentralDifference(Integrator):
         u_new = scaled_plus(dt, v_half, self.u)  # u + Δt v^{n+½}, one compiled pass
         f_int, f_ext, trial = self._forces(u_new, t_new, dt)
         f_damp = self._damping_force(v_half)  # −C v^{n+1/2}: the damping force at t_{n+1}
-        tic = energy_products_start()  # M⁻¹ f, a diagonal solve: timed as a vector update
+        tic = timer_start()  # M⁻¹ f, a diagonal solve: timed as a vector update
         a_new = self._acceleration(f_int if f_damp is None else f_int + f_damp, f_ext)
         vector_updates_done(tic)
         # the step size at t is final now: commit the works of the step that ended at t
@@ -503,7 +503,7 @@ class CentralDifference(Integrator):
             buf = self._work_buffer
             if buf is None or buf.shape != u_new.shape:
                 buf = self._work_buffer = np.empty(u_new.shape)
-            tic = energy_products_start()
+            tic = timer_start()
             products = work_products(u_new, self.u, self._f_int, f_int, buf)
             self._w_internal += self.ops.block_sums(products)
             energy_products_done(tic)

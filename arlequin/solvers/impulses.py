@@ -11,8 +11,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..contract import ConstraintError, same_pattern
-from .active_schur import ActiveSchur
-from .linalg import dense_cho_factor, dense_cho_solve, factor_checked, factor_rows
+from .active_schur import ActiveSchur, cholesky_checked
+from .linalg import dense_cho_solve, factor_checked, factor_rows
 
 __all__ = ["ImpulseSolver"]
 
@@ -176,25 +176,13 @@ class ImpulseSolver:
         return sol[: self.m_e], sol[self.m_e :]
 
     @staticmethod
-    def _cholesky(schur: np.ndarray, m_a: int):
-        """Upper Cholesky factor of the dense (Schur complement) matrix of the active rows.
-
-        Raises :class:`ConstraintError` if it is not positive definite or not finite, or if a
-        pivot keeps less than 1e-14 of its row's diagonal (a row dependent on the others to
-        round-off; :class:`~arlequin.solvers.linalg.ScaledLU` applies 1e-14 to its pivots after
-        a diagonal scaling, relative to the largest)."""
-        msg = ("active unilateral rows are dependent on each other or on the equality rows "
-               f"({m_a} active rows)")  # fmt: skip
-        if not np.isfinite(schur).all():
-            raise ConstraintError(f"the impulse matrix of the {m_a} active rows is not finite")
-        try:
-            cho = dense_cho_factor(schur)
-        except np.linalg.LinAlgError as exc:
-            raise ConstraintError(msg) from exc
-        pivots = np.diagonal(cho[0]) ** 2
-        if not (pivots >= 1e-14 * np.abs(np.diagonal(schur))).all():
-            raise ConstraintError(msg)
-        return cho
+    def _cholesky(schur: np.ndarray, m_a: int) -> tuple[np.ndarray, bool]:
+        """Upper Cholesky factor of the dense (Schur complement) matrix of the ``m_a`` active
+        rows, as ``(U, False)`` for :func:`~arlequin.solvers.linalg.dense_cho_solve`
+        (:func:`~arlequin.solvers.active_schur.cholesky_checked`: raises
+        :class:`ConstraintError` if it is not finite or positive definite, or a row depends
+        on the others)."""
+        return cholesky_checked(schur), False
 
     def _pattern_of(self, g_a: sp.csr_matrix) -> dict:
         """Arrays that depend on the pattern of the active rows G_A alone (their columns, the

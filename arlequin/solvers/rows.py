@@ -28,7 +28,7 @@ from .csr import (
 )
 from .linalg import factor_checked
 from .operators import SystemOperators
-from .timing import energy_products_done, energy_products_start
+from .timing import energy_products_done, timer_start
 from .vector_updates import subtract_scaled_at
 
 logger = logging.getLogger(__name__)
@@ -291,7 +291,7 @@ def unilateral_block_powers(
         index = touched_index(cols, ops.block_of_dof[cols])
         _TOUCHED[0], _TOUCHED[1] = g, (cols, inv, row_of, *index)
     cols, inv, row_of, idx, block = _TOUCHED[1]
-    tic = energy_products_start()
+    tic = timer_start()
     scattered_block_powers(np.ascontiguousarray(g.data, dtype=float),
                            np.ascontiguousarray(lam, dtype=float), row_of, inv, cols.size, x1,
                            x2, len(xs), idx, block, out)  # fmt: skip
@@ -373,7 +373,7 @@ class EqualityRows:
                 shape=(self.n_blocks * self.m, self.cols.size),
             )
         self._coupling_f = self.coupling.astype(float)
-        self._by_kind: tuple[tuple[np.ndarray, ...], np.ndarray] | None = None
+        self._by_kind: tuple[np.ndarray, np.ndarray] | None = None
         self._constant = all(not callable(c.rhs) for c in self.constraints)
         self._g0 = self._g(0.0) if self._constant else None
 
@@ -435,18 +435,6 @@ class EqualityRows:
             return
         subtract_scaled_at(v, self.cols, np.ascontiguousarray(scale), np.ascontiguousarray(x))
 
-    def block_powers_of(
-        self, lam: np.ndarray, vs: Sequence[np.ndarray]
-    ) -> list[tuple[np.ndarray, np.ndarray]]:
-        """:meth:`block_powers` for several vectors x (on every dof, (n,)) with the same
-        multipliers, from the forces: ``−Σ_{j∈b} x_j (B_cᵀλ_c)_j`` and the same with the other
-        rows (:meth:`add_block_powers`, two vectors at a time); the same powers as
-        :meth:`block_powers` up to round-off (the order of the sums)."""
-        out = np.zeros((len(vs), 2, self.n_blocks))
-        for i in range(0, len(vs), 2):
-            self.add_block_powers(lam, vs[i : i + 2], out[i : i + 2])
-        return [(o[0], o[1]) for o in out]
-
     def subtract_impulse(self, v: np.ndarray, scale: np.ndarray, lam: np.ndarray) -> None:
         """``v[self.cols] −= scale ⊙ (Bᵀλ)`` in place (v (n,), scale on the touched dofs, λ
         (m,)): the equality rows' impulse M⁻¹ Bᵀλ, one compiled pass
@@ -476,23 +464,19 @@ class EqualityRows:
         if self.m == 0:
             return
         if self._by_kind is None:
-            # Bᵀ on the touched dofs (each row's entries by increasing row of B, as each kind's
-            # Bᵀ alone has them), the rows' kinds, and the touched dofs with their blocks
-            bt = self.matrix_cols_t  # its rows' entries by increasing row of B (CSC → CSR)
-            if not bt.has_sorted_indices:
-                bt = bt.sorted_indices()
+            # the rows' kinds and the touched dofs with their blocks; Bᵀ is the transpose
+            # product's (its rows' entries by increasing row of B, as each kind's Bᵀ alone)
             other = np.ascontiguousarray(~self.coupling, dtype=np.uint8)
             has = np.array([other.size - other.sum() > 0, other.sum() > 0], dtype=np.uint8)
-            arrays = (np.ascontiguousarray(bt.indptr, dtype=np.int64),
-                      np.ascontiguousarray(bt.indices, dtype=np.uint32),
-                      np.ascontiguousarray(bt.data, dtype=float), other)  # fmt: skip
-            self._by_kind = (arrays, has)
+            self._by_kind = (other, has)
             self._block_sums = touched_index(self.cols, self.block_of_col)
-        arrays, has = self._by_kind
+        other, has = self._by_kind
         idx, block = self._block_sums
-        tic = energy_products_start()
-        kind_block_powers(*arrays, np.ascontiguousarray(lam, dtype=float), x1, x2, len(vs), has,
-                          idx, block, out)  # fmt: skip
+        a = self.transpose_times
+        tic = timer_start()
+        kind_block_powers(a._indptr, a._indices, a._data, other,
+                          np.ascontiguousarray(lam, dtype=float), x1, x2, len(vs), has, idx,
+                          block, out)  # fmt: skip
         energy_products_done(tic)
 
     def row_name(self, i: int) -> str:

@@ -33,7 +33,7 @@ __all__ = [
     "SWITCH",
     "StepTimer",
     "energy_products_done",
-    "energy_products_start",
+    "timer_start",
     "vector_updates_done",
 ]
 
@@ -142,15 +142,15 @@ class StepTimer:
         }
 
 
-def energy_products_start() -> float:
+def timer_start() -> float:
     """The clock of the timer switched on (0.0 when off), before an energy product or a vector
-    update."""
+    update (:func:`energy_products_done`, :func:`vector_updates_done`)."""
     timer = SWITCH.timer
     return timer.clock() if timer is not None else 0.0
 
 
 def energy_products_done(tic: float) -> None:
-    """Count the time since ``tic`` (:func:`energy_products_start`) as linear algebra of the
+    """Count the time since ``tic`` (:func:`timer_start`) as linear algebra of the
     energy bookkeeping (nothing when the timers are off)."""
     timer = SWITCH.timer
     if timer is not None:
@@ -160,7 +160,7 @@ def energy_products_done(tic: float) -> None:
 
 
 def vector_updates_done(tic: float) -> None:
-    """Count the time since ``tic`` (:func:`energy_products_start`) as linear algebra
+    """Count the time since ``tic`` (:func:`timer_start`) as linear algebra
     of the step's vector updates (nothing when the timers are off). For calls outside the other
     timed regions only (no time counted twice)."""
     timer = SWITCH.timer

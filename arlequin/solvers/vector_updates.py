@@ -22,7 +22,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from .timing import energy_products_start, vector_updates_done
+from .timing import timer_start, vector_updates_done
 
 __all__ = ["interpolated", "scaled_plus", "subtract_scaled_at", "sum_of_squares", "work_products"]
 
@@ -85,7 +85,7 @@ def _compiled(*arrays: np.ndarray) -> bool:
 
 def scaled_plus(alpha: float, x: np.ndarray, y: np.ndarray) -> np.ndarray:
     """``alpha x + y``, a new array (n,): the bits of ``z = alpha * x; z += y``."""
-    tic = energy_products_start()
+    tic = timer_start()
     if not _compiled(x, y):
         z = alpha * x
         z += y
@@ -99,7 +99,7 @@ def scaled_plus(alpha: float, x: np.ndarray, y: np.ndarray) -> np.ndarray:
 def interpolated(x0: np.ndarray, x1: np.ndarray, share: float) -> np.ndarray:
     """``x0 + share (x1 − x0)``, a new array (n,): the bits of ``z = x1 − x0; z *= share;
     z += x0``."""
-    tic = energy_products_start()
+    tic = timer_start()
     if not _compiled(x0, x1):
         z = x1 - x0
         z *= share
@@ -130,7 +130,7 @@ def sum_of_squares(*arrays: np.ndarray) -> float:
     numpy's floating-point error state (whose context cost as much as the two products it
     guarded), one call for one or two arrays; its sums run in another order than BLAS's dot,
     so the value differs by round-off."""
-    tic = energy_products_start()
+    tic = timer_start()
     if len(arrays) == 2 and _compiled(arrays[0]) and _compiled(arrays[1]):
         total = float(_sum_of_squares_2(*arrays))
     else:
