@@ -188,6 +188,21 @@ class ResultsFolder:
         self._write_json()
         return series
 
+    def remove_series(self, series: FieldSeries) -> None:
+        """Close a series of this folder and delete its files (``.xdmf``, ``.h5``) and its
+        entry in results.json: a series left without any frame (by an adaptive run's
+        rejected interval, :meth:`DynamicRunWriter.on_rewind
+        <arlequin.io.DynamicRunWriter.on_rewind>`), which would list a field with no data."""
+        series.close()
+        for path in (series.path, series.path.with_suffix(".h5")):
+            path.unlink(missing_ok=True)
+        fields = self.meta["files"].get("fields", {})
+        rel = series.path.relative_to(self.path).as_posix()
+        for name in [k for k, v in fields.items() if v == rel]:
+            del fields[name]
+        self._open = [f for f in self._open if f is not series]
+        self._write_json()
+
     def picture(self, name: str) -> Path:
         """Path of a picture ``NAME.png`` in the folder (registered in results.json)."""
         rel = f"{name}.png"

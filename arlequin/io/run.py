@@ -77,6 +77,7 @@ class DynamicRunWriter:
         self._folder, self._prefix = folder, prefix
         self._meshes = {bf.name: bf.mesh for bf in self.layout.blocks}
         self._pending_series: dict[str, tuple[str, Any]] = {}
+        self._grown: set[str] = set()  # the blocks whose series a growth opened
         self._next = 0
         self._e0: float | None = None
         self.frames_written: list[float] = []
@@ -116,8 +117,16 @@ class DynamicRunWriter:
         self._next = self._row_next[-1] if keep else 0
         if not keep:
             self._e0 = None
-        for series in self.series.values():
+        for name, series in list(self.series.items()):
             series.drop_after(t)
+            if not series.times and name in self._grown:
+                # a growth's series with all its frames in the rejected interval: removed (no
+                # field listed without data), opened again at the next frame unless the growth
+                # that follows the rejection names a newer one first
+                self._folder.remove_series(series)
+                del self.series[name]
+                self._grown.discard(name)
+                self._pending_series.setdefault(name, (series.path.stem, self._meshes[name]))
         self.frames_written = [s for s in self.frames_written if s <= t]
 
     def on_adapt(self, integ: Any, adapt: Any) -> None:
@@ -151,6 +160,7 @@ class DynamicRunWriter:
         (n_cells,) array}} added to the blocks' cell fields."""
         for name, (file, mesh) in self._pending_series.items():
             self.series[name] = self._folder.series(file, mesh)
+            self._grown.add(name)
         self._pending_series = {}
         for name, (point, cell) in self.layout.frame(self.system.dofmap, u, v, multipliers).items():
             self.series[name].write(t, point, {**cell, **(cell_data or {}).get(name, {})})
