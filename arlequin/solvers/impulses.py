@@ -47,6 +47,7 @@ class ImpulseSolver:
         self._eq_t_rows: tuple | None = None  # _shared_part's last slice of Bᵀ
         self._pattern: tuple | None = None  # the last active rows and their pattern's arrays
         self._eq_mask = np.zeros(inv_mass.size, dtype=bool)
+        self._shares: tuple | None = None  # the last active rows and whether they share dofs
         if self.m_e:
             self._eq_mask[rows.cols] = True
         # the equality rows decoupled from the others in S_EE, and their diagonal entries
@@ -71,26 +72,36 @@ class ImpulseSolver:
         """Λ_E (N·s per row unit) of the equality rows alone for the right-hand side r (m_E,)."""
         return self.lu.solve(r) if self.m_e else np.zeros(0)
 
-    def _cached(self, key: tuple, build, owner: Any = None):
-        """The factorisation for the active rows ``key`` (their CSR arrays): the last one if
-        they are the same rows, else ``build()``. One entry: the rows change with the
-        statuses or, on a deforming contact, at every step, so comparing the arrays (a few µs)
-        replaced hashing them (50 µs a step of the ball impact)."""
+    def _cached(self, build, g_a: sp.csr_matrix):
+        """The factorisation for the active rows ``g_a``: the last one if they are the same
+        rows (the same object, or equal CSR arrays), else ``build()``. One entry: the rows
+        change with the statuses or, on a deforming contact, at every step, so comparing the
+        arrays (a few µs) replaced hashing them (50 µs a step of the ball impact)."""
         last = self._last
+        if last is not None and last[2] is g_a:
+            return last[1]
+        key = self._key(g_a)
         if last is not None and (
-            (last[2] is not None and last[2] is owner)
-            or (
-                len(last[0]) == len(key)
-                and all(a.shape == b.shape and np.array_equal(a, b) for a, b in zip(last[0], key))
-            )
+            len(last[0]) == len(key)
+            and all(a.shape == b.shape and np.array_equal(a, b) for a, b in zip(last[0], key))
         ):
             return last[1]
         fac = build()
         # the rows object itself too: the stacked active rows are the same object while they
         # do not change (rows.stack_active) and never modified in place, so that object is a
         # hit without comparing its arrays (20 µs a step of the Taylor bar)
-        self._last = (tuple(np.array(a, copy=True) for a in key), fac, owner)
+        self._last = (tuple(np.array(a, copy=True) for a in key), fac, g_a)
         return fac
+
+    def _shares_equality_dofs(self, g_a: sp.csr_matrix) -> bool:
+        """Whether the active rows touch a dof of the equality rows, remembered for the last
+        rows object (the same object while the statuses hold, never modified in place)."""
+        last = self._shares
+        if last is not None and last[0] is g_a:
+            return last[1]
+        shares = bool(self.m_e) and bool(self._eq_mask[g_a.indices].any())
+        self._shares = (g_a, shares)
+        return shares
 
     @staticmethod
     def _key(g_a: sp.csr_matrix) -> tuple:
@@ -101,7 +112,6 @@ class ImpulseSolver:
         m_a = g_a.shape[0]
         if m_a == 0:
             return self.solve_equality(r_e), np.zeros(0)
-        key = self._key(g_a)
         minv = self.inv_mass
 
         def ga_m() -> sp.csr_matrix:
@@ -110,7 +120,7 @@ class ImpulseSolver:
             return sp.csr_matrix((g_a.data * minv[g_a.indices], g_a.indices.copy(),
                                   g_a.indptr.copy()), shape=g_a.shape)  # fmt: skip
 
-        if self.m_e == 0 or not self._eq_mask[g_a.indices].any():
+        if not self._shares_equality_dofs(g_a):
             # no dof shared with the equality rows (a wall and a symmetry axis), or no equality
             # rows: the active rows' block alone
             def build_aa():
@@ -125,7 +135,7 @@ class ImpulseSolver:
                 s_aa = (ga_m() @ g_a.T).tocsr()
                 return factor_checked(s_aa, "the impulse matrix of the active rows", spd=True)
 
-            lam_a = self._cached(key, build_aa, g_a).solve(r_a)
+            lam_a = self._cached(build_aa, g_a).solve(r_a)
             return (self.solve_equality(r_e) if self.m_e else np.zeros(0)), lam_a
         if m_a <= self._DENSE_SCHUR:
             e_rows, shared, bt = self._shared_part(g_a)
@@ -140,7 +150,7 @@ class ImpulseSolver:
                     return ActiveSchur(g_a, minv, pat["pos"], pat["cols"].size, shared, e_rows,
                                        bt, self._free_diag[e_rows])  # fmt: skip
 
-                factor = self._cached(key, build_decoupled, g_a)
+                factor = self._cached(build_decoupled, g_a)
                 y = self.lu.solve(r_e)
                 return y, factor.solve(r_a, y)
         s_ae = self._s_ae(g_a)
@@ -157,7 +167,7 @@ class ImpulseSolver:
                     schur[:, coupled] -= s_ae @ x
                 return coupled, x, self._cholesky(schur, m_a)
 
-            coupled, x, cho = self._cached(key, build_schur, g_a)
+            coupled, x, cho = self._cached(build_schur, g_a)
             y = self.lu.solve(r_e)
             # a non-finite right-hand side gives NaN impulses, as on the other paths
             lam_a = _DenseFactor(cho).solve(r_a - s_ae @ y)
@@ -172,7 +182,7 @@ class ImpulseSolver:
             full = sp.bmat([[self.s_ee, s_ae.T], [s_ae, s_aa]], format="csc")
             return factor_checked(full, "the impulse matrix with the active rows", spd=True)
 
-        sol = self._cached(key, build_full, g_a).solve(np.concatenate([r_e, r_a]))
+        sol = self._cached(build_full, g_a).solve(np.concatenate([r_e, r_a]))
         return sol[: self.m_e], sol[self.m_e :]
 
     @staticmethod
