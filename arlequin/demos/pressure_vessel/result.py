@@ -53,7 +53,8 @@ class PressureVesselResult(JsonResult):
     n_elements, n_dofs : int
         Cells and dofs of the run (every model's).
     patch_fraction : float
-        The patch's share of the wall's area (1 for ``mono``).
+        The patch's share of the wall's area (volume in 3D): the coarse cells it covers
+        over the coarse mesh, as in the growths' records (1 for ``mono``).
     wall_time_s : float
     history : dict
         Per converged step (the initial state first): ``pressure`` (Pa; under a prescribed

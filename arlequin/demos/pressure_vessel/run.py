@@ -313,18 +313,19 @@ def resume(out: str, progress: Callable[[float], None] | None = None) -> Pressur
 
 
 def _patch_fraction(meshes: Any) -> float:
-    """The patch's share of the wall's area (of its volume for a solid mesh; 1 for mono)."""
-    return 1.0 if meshes.patch is None else _area(meshes.patch) / _area(meshes.coarse)
+    """The patch's share of the wall: the area (a solid mesh: the volume) of the coarse cells
+    it covers over the coarse mesh's, the measure of the growths' records
+    (:attr:`~arlequin.adapt.Adaptation.patch_fraction`), so that the history and the records
+    agree; 1 for mono. The patch is whole rings of coarse cells from the bore: it covers the
+    cells whose nodes all lie within its outer radius (its bore nodes, on the circle, are
+    off the coarse chords, so its own area would differ by those slivers)."""
+    if meshes.patch is None:
+        return 1.0
+    import skfem
 
-
-def _area(mesh: Any) -> float:
-    """The mesh's area (m²), its volume (m³) for a solid mesh (the hexahedra's corners are
-    not those of a polygon: scikit-fem's cell measure)."""
-    if mesh.p.shape[0] == 3:
-        import skfem
-
-        return float(skfem.CellBasis(mesh, mesh.elem()).dx.sum())
-    p = mesh.p[:, mesh.t]  # (2, 4, n): a quadrilateral's area by the shoelace formula
-    x, y = p[0], p[1]
-    return float(0.5 * np.abs(np.sum(x * np.roll(y, -1, axis=0) - y * np.roll(x, -1, axis=0),
-                                     axis=0)).sum())  # fmt: skip
+    coarse = meshes.coarse
+    measure = np.asarray(skfem.CellBasis(coarse, coarse.elem()).dx).sum(axis=1)
+    outer = np.linalg.norm(meshes.patch.p, axis=0).max()
+    radius = np.linalg.norm(coarse.p, axis=0)[coarse.t].max(axis=0)
+    covered = radius <= outer * (1.0 + 1e-9)
+    return float(measure[covered].sum() / measure.sum())
