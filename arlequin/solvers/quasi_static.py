@@ -56,7 +56,9 @@ from .operators import SystemOperators, as_system, as_vector
 from .quasi_static_result import (
     STATUSES,
     CoarseYieldWatch,
+    IterationTracker,
     NewtonError,
+    NewtonIteration,
     QuasiStaticResult,
     QuasiStaticStep,
 )
@@ -64,6 +66,7 @@ from .quasi_static_result import (
 __all__ = [
     "STATUSES",
     "NewtonError",
+    "NewtonIteration",
     "QuasiStaticResult",
     "QuasiStaticSolver",
     "QuasiStaticStep",
@@ -219,15 +222,18 @@ class QuasiStaticSolver(AdaptableSolver):
         scale = max(np.linalg.norm(f_ext), reactions, np.linalg.norm(bt_mu), 1e-300)
         rel = float(np.linalg.norm(r_free) / scale)
         rc = sad.b @ u - g if sad.n_multipliers else np.zeros(0)
+        rel_c = 0.0
         if rc.size:
             cscale = max(np.linalg.norm(abs(sad.b) @ np.abs(u)), np.linalg.norm(g), 1e-300)
-            rel = max(rel, float(np.linalg.norm(rc) / cscale))
-        return r_free, rc, rel
+            rel_c = float(np.linalg.norm(rc) / cscale)
+        # the parts (equilibrium, constraints) for the iterations' records; their max is tested
+        return r_free, rc, max(rel, rel_c), (rel, rel_c)
 
     # -- one load step -----------------------------------------------------------------------
     def _newton(self, lam: float):
         """Newton at load factor ``lam`` from the committed state; returns the converged
-        (u, μ, trial states, residual history) or raises :class:`_StepFailed`."""
+        (u, μ, trial states, residual history, :class:`NewtonIteration` records) or raises
+        :class:`_StepFailed`."""
         fixed_values, _ = self.prescribed(lam)
         # PARDISO's pivoting from this step's first tangent (a resumed run factorises alike)
         self.saddle.direct.renew_analysis()
@@ -238,13 +244,14 @@ class QuasiStaticSolver(AdaptableSolver):
             f_int, trial, kt = self._internal_force(u, tangent=True)
         except StateError as exc:
             raise _StepFailed(str(exc), "state") from exc
-        r_free, rc, rel = self._residual_of(f_int, u, mu, lam)
+        r_free, rc, rel, _ = self._residual_of(f_int, u, mu, lam)
+        track = IterationTracker(self.system, self.states, trial)
         for _ in range(self.max_iterations):
             history.append(rel)
             if not math.isfinite(rel):
                 raise _StepFailed("non-finite residual", "newton")
             if rel <= self.tol:
-                return u, mu, trial, history
+                return u, mu, trial, history, track.records
             if _stagnates(history):
                 raise _StepFailed(
                     f"Newton stagnates (relative residual {rel:.3e} after {len(history) - 1} "
@@ -255,11 +262,12 @@ class QuasiStaticSolver(AdaptableSolver):
                 du, dmu = self.saddle.solve(kt, -r_free, -rc)
             except np.linalg.LinAlgError as exc:
                 raise _StepFailed(f"singular tangent: {exc}", "singular") from exc
-            u, mu, f_int, trial, kt = self._update(u, mu, du, dmu, rel, lam)
-            r_free, rc, rel = self._residual_of(f_int, u, mu, lam)
+            u, mu, f_int, trial, kt, s = self._update(u, mu, du, dmu, rel, lam)
+            r_free, rc, rel, parts = self._residual_of(f_int, u, mu, lam)
+            track.add(trial, rel, parts, s)
         history.append(rel)
         if rel <= self.tol:
-            return u, mu, trial, history
+            return u, mu, trial, history, track.records
         raise _StepFailed(
             f"Newton did not converge in {self.max_iterations} iterations (relative residual "
             f"{rel:.3e} > {self.tol:.1e})",
@@ -306,7 +314,7 @@ class QuasiStaticSolver(AdaptableSolver):
     def _update(self, u, mu, du, dmu, rel, lam):
         """The Newton update u + s Δu, μ + s Δμ: s = 1, or with the line search the largest of
         1, 1/2, 1/4... that lowers the residual; returns it with f_int, the trial states and
-        the tangent there."""
+        the tangent there, and s."""
         free = self.saddle.free
         s = 1.0
         for k in range(self.max_backtracks + 1):
@@ -329,7 +337,7 @@ class QuasiStaticSolver(AdaptableSolver):
             s *= 0.5
         if kt is None:
             f_int, trial, kt = self._internal_force(u_try, tangent=True)
-        return u_try, mu_try, f_int, trial, kt
+        return u_try, mu_try, f_int, trial, kt, s
 
     def step(self) -> QuasiStaticStep:
         """Advance by one load step (cut until it converges); commit it and return it.
@@ -354,7 +362,7 @@ class QuasiStaticSolver(AdaptableSolver):
             if self.load - lam < 1e-12 * abs(self.load):
                 lam = self.load
             try:
-                u, mu, trial, history = self._newton(lam)
+                u, mu, trial, history, records = self._newton(lam)
                 break
             except _StepFailed as fail:
                 if dt / 2.0 < self.min_step * (1.0 - 1e-12):
@@ -363,7 +371,7 @@ class QuasiStaticSolver(AdaptableSolver):
                 self.dt = dt / 2.0
                 cuts += 1
         self._commit(u, mu, trial, lam)
-        rec = QuasiStaticStep(lam, dt, len(history) - 1, tuple(history), cuts)
+        rec = QuasiStaticStep(lam, dt, len(history) - 1, tuple(history), cuts, tuple(records))
         self.history.append(rec)
         if rec.iterations <= self.easy_iterations and cuts == 0:
             self.dt = min(self.nominal, dt * self.growth)
@@ -454,7 +462,7 @@ class QuasiStaticSolver(AdaptableSolver):
         self.mu = self._least_squares_multipliers()
         t0 = time.perf_counter()
         try:
-            u, mu, trial, history = self._newton(self.t)
+            u, mu, trial, history, _ = self._newton(self.t)
         except _StepFailed as fail:
             raise NewtonError(f"re-solving the grown patch at λ = {self.t:.6g} failed: {fail}",
                               step=len(self.history), time=self.t) from fail  # fmt: skip
