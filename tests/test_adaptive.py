@@ -246,7 +246,7 @@ def test_adaptive_sphere_cli_json_series_and_history(tmp_path, capsys):
     mesh, after = read_series(out / "fields" / "patch0_1.xdmf")
     assert len(before) == 3 and len(after) == 2 and "eqps" in after[-1][2]
     assert len(mesh.points) > 0
-    assert len(read_history(out / "newton.csv")["load_factor"]) == 5
+    assert len(read_history(out / "history.csv")["load_factor"]) == 5
     assert (out / "patch_1.png").exists() and (out / "patch_size.png").exists()
     meta = json.loads((out / "results.json").read_text())
     assert meta["results"]["adaptations"]["unit"] == ADAPTATIONS_UNIT
@@ -278,7 +278,7 @@ def test_adaptive_sphere_cap_stops_the_run_with_the_steps_on_disk(tmp_path):
     assert len(info.value.result.steps) == 3
     meta = json.loads((tmp_path / "results.json").read_text())
     assert meta["status"] == "failed"
-    assert len(read_history(tmp_path / "newton.csv")["load_factor"]) == 3
+    assert len(read_history(tmp_path / "history.csv")["load_factor"]) == 3
     # results.json: the unloaded vessel and the three steps (written after every step)
     assert len(meta["results"]["history"]["value"]["pressure"]) == 4
 

@@ -91,7 +91,8 @@ def test_adaptive_plate_grows_and_reports(tmp_path):
     assert u == pytest.approx(ref, rel=1e-4)
     # the folder: a series per patch mesh, one row and one frame per step, a picture a growth
     assert json.loads((out / "results.json").read_text())["status"] == "complete"
-    assert len(read_history(out / "newton.csv")["load_factor"]) == 3
+    # history.csv: first yield (no frame) and the three steps
+    assert len(read_history(out / "history.csv")["load_factor"]) == 4
     frames = sum(len(read_series(p)[1]) for p in (out / "fields").glob("patch0*.xdmf"))
     assert frames == 3
     assert (out / "patch_1.png").exists() and (out / "patch_size.png").exists()
@@ -100,7 +101,7 @@ def test_adaptive_plate_grows_and_reports(tmp_path):
 def test_adaptive_plate_cap_keeps_every_step_on_disk(tmp_path):
     """A cap (0.03 of the plate) below the growth the plastic zone asks for after the first
     step (to 0.0437): PatchLimitError, named; the results folder marked failed, with the
-    converged step in newton.csv, its frame, and the history in results.json."""
+    converged step in history.csv, its frame, and the history in results.json."""
     from arlequin.io import read_history
 
     with pytest.raises(PatchLimitError, match="max_fraction") as info:
@@ -110,7 +111,7 @@ def test_adaptive_plate_cap_keeps_every_step_on_disk(tmp_path):
     assert meta["status"] == "failed" and "max_fraction" in meta["message"]
     history = meta["results"]["history"]["value"]
     # the unloaded plate, first yield, and the converged step(s)
-    assert len(history["load"]) == 2 + len(read_history(tmp_path / "newton.csv")["load_factor"])
+    assert len(history["load"]) == 1 + len(read_history(tmp_path / "history.csv")["load_factor"])
     assert len(history["load"]) >= 3
     assert meta["results"]["adaptations"]["value"]  # the growths made before the cap
 

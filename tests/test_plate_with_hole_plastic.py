@@ -215,7 +215,7 @@ def test_finite_strain_is_refused_without_its_tangent():
 
 def test_cli_writes_the_interface_json_and_a_results_folder(tmp_path, capsys):
     """The command's JSON has the Interface's keys (history: load, displacement,
-    plastic_area); the folder its results.json (inputs with units), newton.csv, one XDMF frame
+    plastic_area); the folder its results.json (inputs with units), history.csv, one XDMF frame
     per step with ε̄p and σ_vm per cell, and the two pictures."""
     from arlequin.cli.main import main
     from arlequin.io import read_history, read_series
@@ -235,8 +235,8 @@ def test_cli_writes_the_interface_json_and_a_results_folder(tmp_path, capsys):
     meta = json.loads((out / "results.json").read_text())
     assert meta["status"] == "complete"
     assert meta["inputs"]["load"] == {"value": 1.9e8, "unit": "Pa"}
-    rows = read_history(out / "newton.csv")
-    assert len(rows["load_factor"]) == 3
+    rows = read_history(out / "history.csv")
+    assert len(rows["load_factor"]) == 4  # first yield (no frame), three steps
     _mesh, frames = read_series(out / "fields" / "patch0.xdmf")
     assert len(frames) == 3
     assert {"eqps", "von_mises", "alpha"} <= set(frames[-1][2])

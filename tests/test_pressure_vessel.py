@@ -163,7 +163,7 @@ def test_cli_writes_the_interface_json_and_a_results_folder(tmp_path, capsys):
     meta = json.loads((out / "results.json").read_text())
     assert meta["status"] == "complete"
     assert meta["inputs"]["yield_stress"] == {"value": 240e6, "unit": "Pa"}
-    rows = read_history(out / "newton.csv")
+    rows = read_history(out / "history.csv")
     assert len(rows["load_factor"]) == 3
     _mesh, frames = read_series(out / "fields" / "patch0.xdmf")
     assert len(frames) == 3 and "eqps" in frames[-1][2]

@@ -17,7 +17,7 @@ import numpy as np
 
 from .fields import read_series
 from .folder import ResultsFolder
-from .history import read_history
+from .history import read_rows
 from .layout import FieldLayout
 
 __all__ = ["DynamicRunWriter", "QuasiStaticRunWriter", "write_static"]
@@ -167,17 +167,35 @@ class DynamicRunWriter:
         self.frames_written.append(float(t))
 
 
+#: The columns of a quasi-static run's ``history.csv`` (one row a converged step; the demo's
+#: measures go between ``load_factor`` and ``load_step``) and their units.
+STEP_COLUMNS = {"step": "1", "load_factor": "1"}
+STEP_NEWTON_COLUMNS = {"load_step": "1", "newton_iterations": "1", "cuts": "1",
+                       "first_residual": "1", "last_residual": "1", "crossings": "1"}  # fmt: skip
+#: The columns of ``newton.csv`` (one row a Newton iteration of a converged step).
+NEWTON_COLUMNS = {"step": "1", "load_factor": "1", "iteration": "1", "start_residual": "1",
+                  "residual": "1", "equilibrium_residual": "1", "constraint_residual": "1",
+                  "line_search": "1", "crossings": "1", "plastic_points": "1"}  # fmt: skip
+
+
 class QuasiStaticRunWriter:
     """Writes a quasi-static run into a results folder as it goes: a listener of
     :func:`arlequin.solvers.solve_quasi_static` (``on_step``), called after every converged
     load step.
 
-    Each step appends a row to ``newton.csv`` (the load factor, its step, Newton iterations,
-    the first and last relative residuals, step cuts) and a frame to every block's field series
-    (displacement, the mediators' multipliers, the blocks' cell data such as ``alpha``, and the
-    cell data ``cell_data(solver)`` returns, e.g. ε̄p and the von Mises stress), at the "time"
-    λ. Frames and rows are flushed as they are written: an interrupted run keeps every
-    converged step.
+    Each step appends a row to ``history.csv``: ``step`` (the solver's converged steps so
+    far), ``load_factor``, the demo's ``measures``, ``load_step`` (its Δλ), the Newton
+    iterations, step cuts, first and last relative residuals, and ``crossings``: the
+    quadrature points that crossed the yield surface in each Newton iteration, one count an
+    iteration separated by spaces (:class:`~arlequin.solvers.quasi_static_result.NewtonIteration`).
+    Each of its Newton iterations appends a row to ``newton.csv``: ``step``, ``load_factor``,
+    ``iteration`` (from 1), ``start_residual`` and ``residual`` (the relative residual before
+    and after it, as the solver compares it with its tolerance), its ``equilibrium_residual``
+    and ``constraint_residual`` parts, ``line_search`` (the update's length), ``crossings``
+    and ``plastic_points``. Then a frame goes to every block's field series (displacement, the
+    mediators' multipliers, the blocks' cell data such as ``alpha``, and the cell data
+    ``cell_data(solver)`` returns, e.g. ε̄p and the von Mises stress), at the "time" λ. Rows
+    and frames are flushed as they are written: an interrupted run keeps every converged step.
 
     Parameters
     ----------
@@ -188,52 +206,65 @@ class QuasiStaticRunWriter:
         ``cell_data(solver) -> {block name: {field name: (n_cells,) array}}``.
     units : mapping, optional
         Units of those fields (recorded in results.json).
+    replay : dict, optional
+        What an interrupted run had written (:meth:`written`), written again first.
+    measures : callable, optional
+        ``measures(solver) -> {name: value}``: the demo's own columns of ``history.csv``.
+    measure_units : mapping, optional
+        Their names, in order, and units.
     """
-
-    columns = ("load_factor", "step", "newton_iterations", "first_residual", "last_residual",
-               "cuts")  # fmt: skip
 
     def __init__(self, folder: ResultsFolder, system: Any, layout: FieldLayout,
                  cell_data: Any = None, units: dict[str, str] | None = None,
-                 replay: dict[str, Any] | None = None) -> None:  # fmt: skip
+                 replay: dict[str, Any] | None = None, measures: Any = None,
+                 measure_units: dict[str, str] | None = None) -> None:  # fmt: skip
         self.system, self.layout, self.cell_data = system, layout, cell_data
+        self.measures = measures
         self._folder = folder
-        self.history = folder.history(
-            self.columns,
-            {
-                "load_factor": "1",
-                "step": "1",
-                "newton_iterations": "1",
-                "first_residual": "1",
-                "last_residual": "1",
-                "cuts": "1",
-            },
-            name="newton",
-        )
+        step_units = {**STEP_COLUMNS, **(measure_units or {}), **STEP_NEWTON_COLUMNS}
+        self.history = folder.history(list(step_units), step_units)
+        self.newton = folder.history(list(NEWTON_COLUMNS), NEWTON_COLUMNS, name="newton")
         self.series = {bf.name: folder.series(bf.name, bf.mesh) for bf in layout.blocks}
         self._meshes = {bf.name: bf.mesh for bf in layout.blocks}
         folder.meta.setdefault("field_units", {}).update({**layout.units, **(units or {})})
-        if replay is not None:  # a resumed run: what the interrupted one had written, first
-            for row in replay["rows"]:
-                self.history.append(row)
-            for name, frames in replay["frames"].items():
-                for t, point, cell in frames:  # meshio gives cell data per cell block
-                    cell = {k: v[0] if isinstance(v, list) else v for k, v in cell.items()}
-                    self.series[name].write(t, point, cell)
+        if replay is not None:
+            self._replay(replay)
+
+    def _replay(self, replay: dict[str, Any]) -> None:
+        """A resumed run: what the interrupted one had written, first (its rows as their
+        text, so that the files equal those of an uninterrupted run; a file of another
+        layout is not written again)."""
+        for writer, name in ((self.history, "history"), (self.newton, "newton")):
+            header, rows = replay["rows"].get(name, (None, []))
+            if header == writer.header:
+                for row in rows:
+                    writer.append_text(row)
+        for name, frames in replay["frames"].items():
+            for t, point, cell in frames:  # meshio gives cell data per cell block
+                cell = {k: v[0] if isinstance(v, list) else v for k, v in cell.items()}
+                self.series[name].write(t, point, cell)
 
     @staticmethod
-    def written(out: str | os.PathLike) -> dict[str, Any]:
+    def written(out: str | os.PathLike, steps: int | None = None,
+                load_factor: float | None = None) -> dict[str, Any]:  # fmt: skip
         """What a writer had written in the folder ``out``: its rows and every series'
-        frames (read before a resumed run's writer opens the files again)."""
+        frames (read before a resumed run's writer opens the files again), those of the first
+        ``steps`` converged steps only (the rows) and of the load factors up to
+        ``load_factor`` (the frames): the ones of its checkpoint, whatever was written after
+        it before the run stopped."""
         out = Path(out)
-        rows: list[dict[str, float]] = []
-        path = out / "newton.csv"
-        if path.is_file():
-            cols = read_history(path)
-            rows = [dict(zip(cols, vals)) for vals in zip(*cols.values())]
-        frames = {
-            p.stem: read_series(p)[1] for p in sorted((out / "fields").glob("*.xdmf"))
-        }  # fmt: skip
+        rows: dict[str, tuple[list[str], list[list[str]]]] = {}
+        for name in ("history", "newton"):
+            path = out / f"{name}.csv"
+            if path.is_file():
+                header, lines = read_rows(path)
+                if steps is not None and header and header[0] == "step [1]":
+                    lines = [r for r in lines if r and int(float(r[0])) <= steps]
+                rows[name] = (header, lines)
+        frames = {p.stem: read_series(p)[1] for p in sorted((out / "fields").glob("*.xdmf"))}
+        if load_factor is not None:
+            limit = load_factor + 1e-12 * max(abs(load_factor), 1.0)
+            frames = {k: [f for f in v if f[0] <= limit] for k, v in frames.items()}
         return {"rows": rows, "frames": frames}
 
     def on_adapt(self, solver: Any, adapt: Any) -> None:
@@ -247,18 +278,31 @@ class QuasiStaticRunWriter:
                 self.series[bf.name] = self._folder.series(f"{bf.name}_{self._growths}", bf.mesh)
                 self._meshes[bf.name] = bf.mesh
 
+    def rows(self, solver: Any) -> None:
+        """The rows of the step just converged (``history.csv``, ``newton.csv``), without a
+        frame (a demo's step whose fields it does not keep)."""
+        rec, step = solver.history[-1], len(solver.history)
+        row = {"step": step, "load_factor": rec.load_factor}
+        if self.measures is not None:
+            row.update(self.measures(solver))
+        newton = getattr(rec, "newton", ())
+        row.update({"load_step": rec.step, "newton_iterations": rec.iterations,
+                    "cuts": rec.cuts, "first_residual": rec.residuals[0],
+                    "last_residual": rec.residuals[-1],
+                    "crossings": " ".join(str(it.crossings) for it in newton)})  # fmt: skip
+        self.history.append(row)
+        for it, start in zip(newton, rec.residuals):
+            self.newton.append({
+                "step": step, "load_factor": rec.load_factor, "iteration": it.iteration,
+                "start_residual": start, "residual": it.residual,
+                "equilibrium_residual": it.equilibrium_residual,
+                "constraint_residual": it.constraint_residual, "line_search": it.line_search,
+                "crossings": it.crossings, "plastic_points": it.plastic_points,
+            })  # fmt: skip
+
     def __call__(self, solver: Any) -> None:
+        self.rows(solver)
         rec = solver.history[-1]
-        self.history.append(
-            {
-                "load_factor": rec.load_factor,
-                "step": rec.step,
-                "newton_iterations": rec.iterations,
-                "first_residual": rec.residuals[0],
-                "last_residual": rec.residuals[-1],
-                "cuts": rec.cuts,
-            }
-        )
         extra = self.cell_data(solver) if self.cell_data is not None else {}
         multipliers = solver.saddle.split_multipliers(solver.mu)
         frames = self.layout.frame(self.system.dofmap, solver.u, None, multipliers)

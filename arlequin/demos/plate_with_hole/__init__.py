@@ -28,8 +28,11 @@ zone nears its gluing band or the coarse stress reaches β σy (default β 0.9),
 points of the band's outer half (α_f < 1/2) disregarded, each growth closed over one-cell
 slots and notches (:func:`.setup.fill_notches`); see ``docs/plate_with_hole.md``.
 
-Outputs (``out``): results.json (inputs and results with units), ``newton.csv`` (per step:
-load factor, Newton iterations, residuals, cuts), the field series of each block
+Outputs (``out``): results.json (inputs and results with units), ``history.csv`` (per
+converged step, first yield included: load factor, nominal stress, the measures of the
+history, Newton iterations, residuals, cuts, the quadrature points that crossed the yield
+surface in each iteration), ``newton.csv`` (per Newton iteration: residuals, crossings), the
+field series of each block
 (``fields/coarse.xdmf``, ``fields/patch0.xdmf``: displacement, α, the mediator's multipliers,
 ε̄p and the von Mises stress per cell, one frame a step), ``load_displacement.png`` and
 ``plastic_zone.png``.

@@ -29,6 +29,9 @@ logger = logging.getLogger(__name__)
 
 #: The load factor of the probing elastic step (λ S, well below first yield).
 PROBE = 1e-3
+#: The recorder's measures in history.csv, with their units (the nominal stress first).
+MEASURE_UNITS = {"load": "Pa", "displacement": "m", "plastic_area": "m^2",
+                 "plastic_extent": "m", "patch_fraction": "1"}  # fmt: skip
 
 
 def plastic_measures(model: Any, eqps: np.ndarray) -> tuple[float, float]:
@@ -108,6 +111,10 @@ class _Recorder:
             value = s.problem.coarse_yield_ratio(solver.u, self.config.yield_stress)
             self.max_coarse_yield_ratio = max(self.max_coarse_yield_ratio, value or 0.0)
 
+    def last(self, solver: Any = None) -> dict[str, float]:
+        """The measures of the last converged state (the columns of history.csv)."""
+        return {k: self.history[k][-1] for k in MEASURE_UNITS}
+
     def results(self) -> dict[str, Any]:
         """What the run has so far (written to results.json after each step, and at a
         failure): every converged state, the growths, the coarse model's largest yield ratio."""
@@ -141,7 +148,8 @@ def _steps(config: PlateWithHoleConfig, setup: PlateSetup, system: Any, recorder
     """The load path: a probing elastic step (:func:`_probe`, giving the load factor λ0 of
     first yield), the elastic step to λ0, then ``config.steps`` equal steps to λ = 1, every
     one by Newton from the last converged displacement and multipliers. Returns the solver and
-    λ0."""
+    λ0. The step to λ0 is recorded, and written to the results folder's rows without a frame
+    (a writer's ``rows``); the probe is not."""
     problem = setup.problem if setup.adapt is None else setup.adapt.bind(setup.problem)
     solver = QuasiStaticSolver(problem, load=1.0, steps=config.steps)
     if setup.adapt is None:
@@ -152,6 +160,9 @@ def _steps(config: PlateWithHoleConfig, setup: PlateSetup, system: Any, recorder
         solver.dt = lam0 - start
         rec = solver.step()
         recorder.append(solver.t, solver.u, None, rec.iterations, rec.residuals)
+        for listener in listeners:
+            if callable(getattr(listener, "rows", None)):
+                listener.rows(solver)
         start = lam0
     solver.nominal = solver.dt = (1.0 - start) / config.steps
     solver.min_step = solver.nominal / 2**10
@@ -246,7 +257,9 @@ def _listeners(setup: PlateSetup, system: Any, folder: ResultsFolder | None,
 
         layout = setup.problem.field_layout()
         units = {"eqps": "1", "von_mises": "Pa"}
-        listeners.append(QuasiStaticRunWriter(folder, system, layout, cell_fields(setup), units))
+        listeners.append(QuasiStaticRunWriter(folder, system, layout, cell_fields(setup), units,
+                                              measures=recorder.last,
+                                              measure_units=MEASURE_UNITS))  # fmt: skip
         listeners.append(lambda solver: folder.add_results(recorder.results(), UNITS))
         if setup.adapt is not None:
             listeners.append(AdaptationPictures(folder, setup, recorder.config.radius,

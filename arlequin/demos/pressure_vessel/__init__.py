@@ -13,8 +13,10 @@ Exact references (:mod:`arlequin.demos.pressure_vessel.hill`): for the sphere Hi
 (first yield, the plastic front c, the outer displacement u_b, the limit load), for the
 cylinder first yield and the limit load.
 
-Outputs (``out``): results.json (inputs and results with units), history.csv is replaced by
-``newton.csv`` (per step: load factor, Newton iterations, residuals, cuts), the field series
+Outputs (``out``): results.json (inputs and results with units), ``history.csv`` (per
+converged step: load factor, pressure, plastic front, displacements, Newton iterations,
+residuals, cuts, the quadrature points that crossed the yield surface in each iteration),
+``newton.csv`` (per Newton iteration: residuals, crossings), the field series
 ``fields/coarse.xdmf`` and ``fields/patch0.xdmf`` (displacement, α, the mediator's multipliers,
 ε̄p and the von Mises stress per cell, one frame a step), ``pressure_displacement.png`` and
 ``plastic_zone.png``.

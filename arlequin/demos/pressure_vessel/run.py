@@ -35,6 +35,10 @@ __all__ = ["CHECKPOINT", "CoarseYieldWarning", "resume", "run"]
 
 logger = logging.getLogger(__name__)
 
+#: The recorder's measures in history.csv, with their units (the load first).
+MEASURE_UNITS = {"pressure": "Pa", "plastic_radius": "m", "outer_displacement": "m",
+                 "inner_displacement": "m", "patch_fraction": "1"}  # fmt: skip
+
 
 class _Recorder:
     """The history of a run, one entry per converged step (an ``on_step`` listener)."""
@@ -100,6 +104,10 @@ class _Recorder:
         self.max_coarse_yield_ratio = max(self.max_coarse_yield_ratio, self._coarse_ratio(solver))
 
     max_coarse_yield_ratio = 0.0
+
+    def last(self, solver: Any = None) -> dict[str, float]:
+        """The measures of the last converged step (the columns of history.csv)."""
+        return {k: self.history[k][-1] for k in MEASURE_UNITS}
 
     def _coarse_ratio(self, solver: Any) -> float:
         """The largest von Mises / σy of the coarse elastic model outside the patch (0 for
@@ -245,7 +253,8 @@ def _listeners(config, setup, folder, recorder, first_yield, progress, restore) 
         units = {"eqps": "1", "von_mises": "Pa"}
         replay = None if restore is None else restore["replay"]
         writer = QuasiStaticRunWriter(folder, system, layout, cell_fields(setup), units,
-                                      replay=replay)  # fmt: skip
+                                      replay=replay, measures=recorder.last,
+                                      measure_units=MEASURE_UNITS)  # fmt: skip
         listeners.append(writer)
         if setup.adapt is not None:
             listeners.append(AdaptationPictures(folder, setup, recorder.history))
@@ -308,7 +317,10 @@ def resume(out: str, progress: Callable[[float], None] | None = None) -> Pressur
     step (its checkpoint), with the inputs it was started with; the same steps and values as
     the uninterrupted run. Runs with a growing patch write no checkpoint."""
     snap = read_checkpoint(Path(out) / CHECKPOINT)
-    snap["replay"] = QuasiStaticRunWriter.written(out)
+    # the rows and frames of the checkpoint's steps (not those written after it, if any)
+    solver = snap["solver"]
+    snap["replay"] = QuasiStaticRunWriter.written(out, steps=len(solver["history"]),
+                                                  load_factor=solver["t"])  # fmt: skip
     return run(snap["config"], out=out, progress=progress, restore=snap)
 
 
