@@ -69,38 +69,10 @@ def read_mesh(source: Any, scale: float = 1.0) -> skfem.Mesh:
     FileNotFoundError
         No such file.
     """
-    import meshio
-
     if not (isinstance(scale, (int, float)) and np.isfinite(scale) and scale > 0):
         raise ValueError(f"scale must be a positive number (file unit -> m), got scale={scale!r}")
-    name = "the mesh"
-    if not isinstance(source, meshio.Mesh):
-        name = f"mesh file {os.fspath(source)!r}"
-        if not os.path.isfile(os.fspath(source)):
-            raise FileNotFoundError(f"{name} not found")
-        try:
-            source = meshio.read(os.fspath(source))
-        except SystemExit as exc:  # meshio exits on a file no reader accepts
-            raise MeshError(
-                f"{name}: meshio could not read it (not a mesh, or a format it "
-                "guesses wrongly from the extension)"
-            ) from exc
-        except Exception as exc:
-            raise MeshError(f"{name}: meshio could not read it: {exc}") from exc
-    types = sorted({block.type for block in source.cells if len(block.data)})
-    if not types:
-        raise UnsupportedMeshError(f"{name} has no cells")
-    top = max(_dimension(t) for t in types)
-    main = [t for t in types if _dimension(t) == top]
-    if len(main) > 1:
-        raise UnsupportedMeshError(f"{name} mixes cell types {main} in dimension {top}: the "
-                                   "library's models take one type a mesh (split it into "
-                                   "one mesh per type)")  # fmt: skip
-    kind = main[0]
-    if kind not in SUPPORTED:
-        raise UnsupportedMeshError(f"{name} has cells of type {kind!r}, which no model of the "
-                                   f"library supports: give first-order {list(SUPPORTED)} "
-                                   "cells (e.g. Gmsh's Mesh.ElementOrder = 1)")  # fmt: skip
+    source, name = _read_source(source)
+    kind, top = _main_type(source, name)
     points = np.asarray(source.points, dtype=float)
     if top == 2 and points.shape[1] == 3 and np.ptp(points[:, 2]) > 0.0:
         raise MeshError(f"{name}: {kind} cells in 3D space (z from {points[:, 2].min():.6g} to "
@@ -116,3 +88,43 @@ def read_mesh(source: Any, scale: float = 1.0) -> skfem.Mesh:
         mesh = mesh.scaled([float(scale)] * mesh.dim())
     check_mesh(mesh, what=name)
     return mesh
+
+
+def _read_source(source: Any) -> tuple[Any, str]:
+    """The ``meshio.Mesh`` of ``source`` (read if a path) and its name in error messages."""
+    import meshio
+
+    if isinstance(source, meshio.Mesh):
+        return source, "the mesh"
+    name = f"mesh file {os.fspath(source)!r}"
+    if not os.path.isfile(os.fspath(source)):
+        raise FileNotFoundError(f"{name} not found")
+    try:
+        return meshio.read(os.fspath(source)), name
+    except SystemExit as exc:  # meshio exits on a file no reader accepts
+        raise MeshError(
+            f"{name}: meshio could not read it (not a mesh, or a format it "
+            "guesses wrongly from the extension)"
+        ) from exc
+    except Exception as exc:
+        raise MeshError(f"{name}: meshio could not read it: {exc}") from exc
+
+
+def _main_type(source: Any, name: str) -> tuple[str, int]:
+    """The one cell type of the highest dimension of a ``meshio.Mesh`` and that dimension,
+    refused unless single and supported (:data:`SUPPORTED`)."""
+    types = sorted({block.type for block in source.cells if len(block.data)})
+    if not types:
+        raise UnsupportedMeshError(f"{name} has no cells")
+    top = max(_dimension(t) for t in types)
+    main = [t for t in types if _dimension(t) == top]
+    if len(main) > 1:
+        raise UnsupportedMeshError(f"{name} mixes cell types {main} in dimension {top}: the "
+                                   "library's models take one type a mesh (split it into "
+                                   "one mesh per type)")  # fmt: skip
+    kind = main[0]
+    if kind not in SUPPORTED:
+        raise UnsupportedMeshError(f"{name} has cells of type {kind!r}, which no model of the "
+                                   f"library supports: give first-order {list(SUPPORTED)} "
+                                   "cells (e.g. Gmsh's Mesh.ElementOrder = 1)")  # fmt: skip
+    return kind, top

@@ -224,6 +224,35 @@ def _match(old: np.ndarray, new: np.ndarray, tol: float) -> tuple[np.ndarray, np
     return np.nonzero(hit)[0], idx[hit]
 
 
+def _check_settings(
+    threshold: Any, buffer: Any, band_cells: Any, every: Any, patch: Any, interval: Any
+) -> None:
+    """:class:`AdaptivePatch`'s threshold, counts and check interval, each named if wrong."""
+    if not (_is_real(threshold) and 0.0 < threshold <= 1.0):
+        raise ValueError(f"threshold β must lie in (0, 1], got threshold={threshold!r}")
+    for name, value, low in (("buffer", buffer, 0), ("band_cells", band_cells, 0),
+                             ("every", every, 1), ("patch", patch, 0)):  # fmt: skip
+        if isinstance(value, bool) or int(value) != value or value < low:
+            raise ValueError(f"{name} must be an integer >= {low}, got {name}={value!r}")
+    if interval is not None and not (
+        _is_real(interval) and math.isfinite(interval) and interval > 0.0
+    ):
+        raise ValueError(f"interval must be a positive time (s), got interval={interval!r}")
+
+
+def _check_bounds(max_fraction: Any, band_weight: Any, levels: Any, indicator: Any) -> None:
+    """:class:`AdaptivePatch`'s fraction, band weight, levels and indicator, each named if
+    wrong."""
+    if not (_is_real(max_fraction) and 0.0 < max_fraction <= 1.0):
+        raise ValueError(f"max_fraction must lie in (0, 1], got max_fraction={max_fraction!r}")
+    if not (_is_real(band_weight) and 0.0 <= band_weight < 1.0):
+        raise ValueError(f"band_weight must lie in [0, 1), got band_weight={band_weight!r}")
+    if levels is not None and (int(levels) != levels or levels < 0):
+        raise ValueError(f"levels must be a non-negative integer, got levels={levels}")
+    if indicator is not None and not callable(indicator):
+        raise ValueError(f"indicator must be callable, got {type(indicator).__name__}")
+
+
 class AdaptivePatch:
     """A nested patch that grows where the material starts to yield (module docstring).
 
@@ -292,25 +321,9 @@ class AdaptivePatch:
         interval: float | None = None,
         band_weight: float = 0.0,
     ) -> None:
-        if not (_is_real(threshold) and 0.0 < threshold <= 1.0):
-            raise ValueError(f"threshold β must lie in (0, 1], got threshold={threshold!r}")
-        for name, value, low in (("buffer", buffer, 0), ("band_cells", band_cells, 0),
-                                 ("every", every, 1), ("patch", patch, 0)):  # fmt: skip
-            if isinstance(value, bool) or int(value) != value or value < low:
-                raise ValueError(f"{name} must be an integer >= {low}, got {name}={value!r}")
-        if interval is not None and not (
-            _is_real(interval) and math.isfinite(interval) and interval > 0.0
-        ):
-            raise ValueError(f"interval must be a positive time (s), got interval={interval!r}")
+        _check_settings(threshold, buffer, band_cells, every, patch, interval)
         self.interval = None if interval is None else float(interval)
-        if not (_is_real(max_fraction) and 0.0 < max_fraction <= 1.0):
-            raise ValueError(f"max_fraction must lie in (0, 1], got max_fraction={max_fraction!r}")
-        if not (_is_real(band_weight) and 0.0 <= band_weight < 1.0):
-            raise ValueError(f"band_weight must lie in [0, 1), got band_weight={band_weight!r}")
-        if levels is not None and (int(levels) != levels or levels < 0):
-            raise ValueError(f"levels must be a non-negative integer, got levels={levels}")
-        if indicator is not None and not callable(indicator):
-            raise ValueError(f"indicator must be callable, got {type(indicator).__name__}")
+        _check_bounds(max_fraction, band_weight, levels, indicator)
         self.model_factory, self.levels, self.refine = model_factory, levels, refine
         self.threshold, self.buffer, self.band_cells = float(threshold), int(buffer), band_cells
         self.every, self.max_fraction, self.indicator = int(every), float(max_fraction), indicator

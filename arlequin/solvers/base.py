@@ -160,20 +160,7 @@ class Integrator:
             system, self.lumped_default if lumped is None else lumped, tangent=tangent
         )
         all_constraints = list(system.constraints) + list(constraints)
-        for k, c in enumerate(all_constraints):
-            if not (isinstance(c, LinearConstraint) or is_unilateral(c)):
-                raise ContractError(
-                    f"constraint {k} is a {type(c).__name__}: give LinearConstraint rows or "
-                    "objects of the UnilateralConstraint protocol (arlequin.contract)"
-                )
-        self.unilateral: list[UnilateralConstraint] = [c for c in all_constraints
-                                                       if is_unilateral(c)]  # fmt: skip
-        for c in self.unilateral:
-            if getattr(c, "explicit_only", False) and not self.applies_multipliers:
-                raise ValueError(
-                    f"constraint {c.name!r} prescribes multipliers (slip friction): "
-                    f"it runs with the explicit integrator, not {self.name!r}"
-                )
+        self.unilateral: list[UnilateralConstraint] = self._unilateral_of(all_constraints)
         self.rows = self._equality_rows([c for c in all_constraints if not is_unilateral(c)])
         names = [c.name for c in self.unilateral] + list(self.rows.slices)
         if len(set(names)) != len(names):
@@ -181,6 +168,43 @@ class Integrator:
         caps = [c.max_iterations for c in self.unilateral]
         self.max_status_iterations = int(max_status_iterations or (max(caps) if caps else 1))
         self.check_finite = bool(check_finite)
+        self._init_clock(t0)
+        self.controller: StepController = self._controller_of(dt, step_controller)
+        self.dt = self._checked_step(self.controller.propose(self))
+        u = as_vector(u0, system, "u0 (initial displacement)")
+        v = as_vector(v0, system, "v0 (initial velocity)")
+        if consistent_initial and self.rows.m:
+            u, v = consistent_initial_state(self.rows, self.ops, self.t, self.dt, u, v)
+        self.u = u
+        self.v = v
+        self.a = np.zeros_like(u)
+        self.constraint_states = {c.name: c.initial_state(u, v) for c in self.unilateral}
+        self._stack_cache: dict = {}  # stack_active's last stacked rows
+        # whether the last active rows (_active) had a displacement-level row: their impulse
+        # right-hand side needs G_A u then
+        self._active_displacement_rows = False
+        self._initialize()
+
+    def _unilateral_of(self, all_constraints: list[Any]) -> list[UnilateralConstraint]:
+        """The unilateral constraints of ``all_constraints``, each checked to be either
+        :class:`LinearConstraint` rows or a unilateral constraint this scheme can run."""
+        for k, c in enumerate(all_constraints):
+            if not (isinstance(c, LinearConstraint) or is_unilateral(c)):
+                raise ContractError(
+                    f"constraint {k} is a {type(c).__name__}: give LinearConstraint rows or "
+                    "objects of the UnilateralConstraint protocol (arlequin.contract)"
+                )
+        unilateral = [c for c in all_constraints if is_unilateral(c)]
+        for c in unilateral:
+            if getattr(c, "explicit_only", False) and not self.applies_multipliers:
+                raise ValueError(
+                    f"constraint {c.name!r} prescribes multipliers (slip friction): "
+                    f"it runs with the explicit integrator, not {self.name!r}"
+                )
+        return unilateral
+
+    def _init_clock(self, t0: float) -> None:
+        """The initial time, the step counters and statuses, the states and the works."""
         self.t = float(t0)
         if not math.isfinite(self.t):
             raise ValueError(f"initial time must be finite, got t0={t0}")
@@ -201,24 +225,13 @@ class Integrator:
         self._w_internal = np.zeros(nb)
         self._w_damping = np.zeros(nb)
         self.multipliers: dict[str, np.ndarray] = {}
+
+    def _controller_of(self, dt: float | None, step_controller: Any) -> StepController:
+        """The step controller: ``step_controller``, else a fixed ``dt``, else the scheme's."""
         controller = as_controller(step_controller)
         if controller is None:
             controller = as_controller(dt) if dt is not None else self._default_controller()
-        self.controller: StepController = controller
-        self.dt = self._checked_step(self.controller.propose(self))
-        u = as_vector(u0, system, "u0 (initial displacement)")
-        v = as_vector(v0, system, "v0 (initial velocity)")
-        if consistent_initial and self.rows.m:
-            u, v = consistent_initial_state(self.rows, self.ops, self.t, self.dt, u, v)
-        self.u = u
-        self.v = v
-        self.a = np.zeros_like(u)
-        self.constraint_states = {c.name: c.initial_state(u, v) for c in self.unilateral}
-        self._stack_cache: dict = {}  # stack_active's last stacked rows
-        # whether the last active rows (_active) had a displacement-level row: their impulse
-        # right-hand side needs G_A u then
-        self._active_displacement_rows = False
-        self._initialize()
+        return controller
 
     # ------------------------------------------------------------------ scheme hooks
     def _equality_rows(self, constraints: list[LinearConstraint]) -> EqualityRows:

@@ -260,14 +260,11 @@ class CentralDifference(Integrator):
         as forces, G_A, v_new, trials).
         """
         rows = self.rows
-        dt = self.dt
-        u, t = self.u, self.t
         solver = self._impulse_solver()
         t_next = self._end_time()
         timer = SWITCH.timer
         tic = timer.clock() if timer is not None else 0.0
-        r_e = self._rhs_equality(v_star, u, t_next) if rows.m else np.zeros(0)
-        minv = self.ops.inv_mass
+        r_e = self._rhs_equality(v_star, self.u, t_next) if rows.m else np.zeros(0)
         if not self.unilateral:
             lam_e = solver.solve_equality(r_e)
             v_new = v_star
@@ -279,10 +276,22 @@ class CentralDifference(Integrator):
             return lam_e, self._no_lam, [], self._no_rows, v_new, []
         if timer is not None:
             timer.linear_algebra += timer.clock() - tic
-        trials = self._begin_unilateral(t, dt, u, v_star)
+        return self._status_loop(solver, v_star, r_e, dt_bar, t_next)
+
+    def _status_loop(
+        self, solver: ImpulseSolver, v_free: np.ndarray, r_e0: np.ndarray, dt_bar: float,
+        t_next: float,
+    ):  # fmt: skip
+        """The impulse with unilateral constraints: their statuses iterated from their trials
+        at t (``v_free`` the free prediction, ``r_e0`` the equality rows' right-hand side for
+        it); returns what :meth:`_impulse` does."""
+        rows = self.rows
+        dt = self.dt
+        u, t = self.u, self.t
+        minv = self.ops.inv_mass
+        trials = self._begin_unilateral(t, dt, u, v_free)
         converged = False
         it = 0
-        v_free, r_e0 = v_star, r_e
         while it < self.max_status_iterations:
             it += 1
             g_a, rhs_a, idx, disp = self._active(trials)
@@ -293,23 +302,7 @@ class CentralDifference(Integrator):
             if f_app is not None:
                 v_star = v_free + dt_bar * minv * f_app
                 r_e = self._rhs_equality(v_star, u, t_next) if rows.m else r_e0
-            # velocity-level rows (contact) target rhs_a itself: no product with u for them
-            tic = timer.clock() if timer is not None else 0.0
-            w_a = np.where(disp, (rhs_a - g_a @ u) / dt, rhs_a) \
-                if self._active_displacement_rows else rhs_a  # fmt: skip
-            r_a = rows_times(g_a, v_star) - w_a
-            lam_e, lam_a = solver.solve(r_e, g_a, r_a)
-            v_new = v_star.copy()
-            if rows.m:
-                rows.subtract_impulse(v_new, self._minv_cols, lam_e)
-            if g_a.shape[0]:
-                # M⁻¹ Gᵀλ subtracted on G_A's columns alone (no n-vector for a few rows)
-                scratch = self._columns_scratch
-                if scratch is None or scratch.shape != minv.shape:
-                    scratch = self._columns_scratch = np.zeros(minv.shape)
-                subtract_transposed(g_a, lam_a, minv, v_new, scratch)
-            if timer is not None:
-                timer.linear_algebra += timer.clock() - tic
+            lam_e, lam_a, v_new = self._solve_impulses(solver, v_star, r_e, g_a, rhs_a, disp)
             fulls = self._full_multipliers(lam_a / dt_bar, idx)
             if f_app is not None:
                 fulls = [f if a is None else f + a for f, a in zip(fulls, applied)]
@@ -325,6 +318,37 @@ class CentralDifference(Integrator):
             # the step keeps the last solve; each constraint commits what it used in it
             self._status_cap_reached(t_next)
         return lam_e, lam_a, fulls, g_a, v_new, trials
+
+    def _solve_impulses(
+        self, solver: ImpulseSolver, v_star: np.ndarray, r_e: np.ndarray, g_a, rhs_a: np.ndarray,
+        disp: np.ndarray,
+    ):  # fmt: skip
+        """One status iteration's solve: (Λ_E, Λ_A) of the equality rows (right-hand side
+        ``r_e``) and the active rows ``g_a`` (targets ``rhs_a``, displacement-level where
+        ``disp``), and the velocity ``v_star − M⁻¹BᵀΛ`` (a new array)."""
+        rows = self.rows
+        dt = self.dt
+        u = self.u
+        minv = self.ops.inv_mass
+        timer = SWITCH.timer
+        # velocity-level rows (contact) target rhs_a itself: no product with u for them
+        tic = timer.clock() if timer is not None else 0.0
+        w_a = np.where(disp, (rhs_a - g_a @ u) / dt, rhs_a) \
+            if self._active_displacement_rows else rhs_a  # fmt: skip
+        r_a = rows_times(g_a, v_star) - w_a
+        lam_e, lam_a = solver.solve(r_e, g_a, r_a)
+        v_new = v_star.copy()
+        if rows.m:
+            rows.subtract_impulse(v_new, self._minv_cols, lam_e)
+        if g_a.shape[0]:
+            # M⁻¹ Gᵀλ subtracted on G_A's columns alone (no n-vector for a few rows)
+            scratch = self._columns_scratch
+            if scratch is None or scratch.shape != minv.shape:
+                scratch = self._columns_scratch = np.zeros(minv.shape)
+            subtract_transposed(g_a, lam_a, minv, v_new, scratch)
+        if timer is not None:
+            timer.linear_algebra += timer.clock() - tic
+        return lam_e, lam_a, v_new
 
     def _applied_force(self, trials, applied) -> np.ndarray | None:
         """−Σ Bᵀ λ_applied (N) of the trials' prescribed multipliers, or None without any."""

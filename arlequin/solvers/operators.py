@@ -215,20 +215,7 @@ class SystemOperators:
             Tangent (N/m) when ``tangent`` is True (see the ``tangent`` parameter of the class).
         """
         timer = SWITCH.timer
-        tic = timer.clock() if timer is not None else 0.0
-        if blocks is not None:
-            if tangent:
-                raise ValueError("internal_force: a tangent is assembled for every block")
-            idx, k_rows, terms = self._rows_of(tuple(blocks))
-            f = np.zeros(u.shape)
-            if k_rows is not None:
-                f[idx] = k_rows(u)
-        else:
-            # the assembled (linear) part; nothing to multiply when every term is nonlinear
-            f = self._stiffness_times(u) if self.stiffness.nnz else np.zeros(u.shape)
-            terms = self._nonlinear_terms
-        if timer is not None:
-            timer.linear_algebra += timer.clock() - tic
+        f, terms = self._linear_force(u, tangent, blocks)
         trial = {name: list(s) for name, s in states.items()}
         if not terms:
             return f, trial, (self.stiffness if tangent else None)
@@ -257,15 +244,7 @@ class SystemOperators:
             else:
                 f[dofs] += term.sign * ft
             if tangent:
-                if self.tangent_kind == "consistent":
-                    if uses_dt:  # rates: the same dt
-                        kt = term.model.tangent(ut, state, term.weight, dt=dt)
-                    else:
-                        kt = term.model.tangent(ut, state, term.weight)
-                    kt = sp.csr_matrix(kt)
-                else:
-                    kt = sp.csr_matrix(term.model.stiffness(term.weight))
-                kb = term.sign * (kt if p is None else (p.T @ kt @ p))
+                kb = self._term_tangent(term, ut, state, dt, uses_dt)
                 kt_blocks[bi] = kb if bi not in kt_blocks else kt_blocks[bi] + kb
         kt_full = None
         if tangent:
@@ -275,6 +254,45 @@ class SystemOperators:
             ]
             kt_full = (self.stiffness + sp.block_diag(blocks, format="csr")).tocsr()
         return f, trial, kt_full
+
+    def _linear_force(
+        self, u: np.ndarray, tangent: bool, blocks: Sequence[int] | None
+    ) -> tuple[np.ndarray, list]:
+        """The assembled (linear) part of :meth:`internal_force` (of ``blocks`` only, if given)
+        and the nonlinear terms left to evaluate (block index, term index, term)."""
+        timer = SWITCH.timer
+        tic = timer.clock() if timer is not None else 0.0
+        if blocks is not None:
+            if tangent:
+                raise ValueError("internal_force: a tangent is assembled for every block")
+            idx, k_rows, terms = self._rows_of(tuple(blocks))
+            f = np.zeros(u.shape)
+            if k_rows is not None:
+                f[idx] = k_rows(u)
+        else:
+            # the assembled (linear) part; nothing to multiply when every term is nonlinear
+            f = self._stiffness_times(u) if self.stiffness.nnz else np.zeros(u.shape)
+            terms = self._nonlinear_terms
+        if timer is not None:
+            timer.linear_algebra += timer.clock() - tic
+        return f, terms
+
+    def _term_tangent(
+        self, term: Any, ut: np.ndarray, state: Any, dt: float | None, uses_dt: bool
+    ) -> sp.csr_matrix:
+        """The signed tangent (N/m) of one nonlinear term at its displacement ``ut`` from its
+        committed ``state``, on its block's dofs (the consistent one, or the initial stiffness
+        with ``tangent="initial"``)."""
+        if self.tangent_kind == "consistent":
+            if uses_dt:  # rates: the same dt
+                kt = term.model.tangent(ut, state, term.weight, dt=dt)
+            else:
+                kt = term.model.tangent(ut, state, term.weight)
+            kt = sp.csr_matrix(kt)
+        else:
+            kt = sp.csr_matrix(term.model.stiffness(term.weight))
+        p = term.transfer
+        return term.sign * (kt if p is None else (p.T @ kt @ p))
 
     def _force_terms(self, terms: list) -> list[tuple]:
         """``terms`` (block index, term index, term) with their block's dofs (a slice), name

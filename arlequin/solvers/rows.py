@@ -94,6 +94,25 @@ def stack_active(trials: Sequence, n: int, cache: dict | None = None):
     rhs_a = _active_rhs(trials, idx)
     mats = [tr.matrix if getattr(tr.matrix, "format", None) == "csr" else
             sp.csr_matrix(tr.matrix) for tr in trials]  # fmt: skip
+    g_a = _stacked_rows(trials, mats, idx, n, cache)
+    if cache is not None:
+        # the matrices and right-hand sides are kept alive with the key so that their ids
+        # cannot be reused
+        for a in (*idx, rhs_a):
+            a.flags.writeable = False
+        cache.update(key=key, g_a=g_a, matrices=[tr.matrix for tr in trials], idx=idx,
+                     rhs_of=[tr.rhs for tr in trials], rhs_a=rhs_a)  # fmt: skip
+        idx = list(idx)
+    return g_a, rhs_a, idx
+
+
+def _stacked_rows(
+    trials: Sequence, mats: Sequence[sp.csr_matrix], idx: Sequence[np.ndarray], n: int,
+    cache: dict | None,
+) -> sp.csr_matrix:  # fmt: skip
+    """The active rows ``idx`` of the CSR matrices ``mats`` (the trials'), stacked (m_A, n):
+    from a kept pattern of :func:`stack_active`'s cache when the matrices' index arrays and
+    active rows are those of one, else gathered (and their pattern kept when shared)."""
     # new matrices on the same patterns (index arrays, shared while a deforming contact's
     # points keep their facets: csr_pattern) with the same active rows: the stacked rows'
     # pattern and the gathers kept, only the entries taken (no scipy constructor a step)
@@ -106,31 +125,20 @@ def stack_active(trials: Sequence, n: int, cache: dict | None = None):
     entry = patterns.pop(pattern_key, None) if patterns is not None else None
     if entry is not None:
         patterns[pattern_key] = entry  # the most recent again
-        g_a = csr_with_data(entry[0], np.concatenate([m.data[p] for m, p in zip(mats, entry[1])]))
-    else:
-        data, indices, indptr, pos = _stack_rows(mats, idx, n)
-        shape = (indptr.size - 1, n)
-        # a template only for read-only index arrays (csr_pattern's: never changed), kept with
-        # the index arrays so that their ids cannot be reused
-        shared = all(not m.indices.flags.writeable and not m.indptr.flags.writeable
-                     for m in mats)  # fmt: skip
-        if patterns is not None and shared:
-            template = csr_pattern(indices, indptr, shape)
-            patterns[pattern_key] = (template, pos, [(m.indices, m.indptr) for m in mats])
-            if len(patterns) > _KEPT_PATTERNS:
-                del patterns[next(iter(patterns))]  # the least recently used
-            g_a = csr_with_data(template, data)
-        else:
-            g_a = sp.csr_matrix((data, indices, indptr), shape=shape)
-    if cache is not None:
-        # the matrices and right-hand sides are kept alive with the key so that their ids
-        # cannot be reused
-        for a in (*idx, rhs_a):
-            a.flags.writeable = False
-        cache.update(key=key, g_a=g_a, matrices=[tr.matrix for tr in trials], idx=idx,
-                     rhs_of=[tr.rhs for tr in trials], rhs_a=rhs_a)  # fmt: skip
-        idx = list(idx)
-    return g_a, rhs_a, idx
+        return csr_with_data(entry[0], np.concatenate([m.data[p] for m, p in zip(mats, entry[1])]))
+    data, indices, indptr, pos = _stack_rows(mats, idx, n)
+    shape = (indptr.size - 1, n)
+    # a template only for read-only index arrays (csr_pattern's: never changed), kept with
+    # the index arrays so that their ids cannot be reused
+    shared = all(not m.indices.flags.writeable and not m.indptr.flags.writeable
+                 for m in mats)  # fmt: skip
+    if patterns is not None and shared:
+        template = csr_pattern(indices, indptr, shape)
+        patterns[pattern_key] = (template, pos, [(m.indices, m.indptr) for m in mats])
+        if len(patterns) > _KEPT_PATTERNS:
+            del patterns[next(iter(patterns))]  # the least recently used
+        return csr_with_data(template, data)
+    return sp.csr_matrix((data, indices, indptr), shape=shape)
 
 
 def _active_rhs(trials: Sequence, idx: Sequence[np.ndarray]) -> np.ndarray:

@@ -100,13 +100,7 @@ def _check_case(demo: str, params: Mapping[str, Any], parser) -> None:
         if key in ("json", "out", "quiet", "help", "resume"):
             raise StudyError(f"parameter {key!r} is set by the study itself")
         if key not in opts:
-            import difflib
-
-            known = sorted(k for k in opts if k not in ("json", "out", "quiet", "help"))
-            close = difflib.get_close_matches(key, known, n=1)
-            hint = f"; did you mean {close[0]!r}?" if close else ""
-            raise StudyError(f"parameter {key!r} is not an option of {demo!r}{hint} "
-                             f"(options: {known})")  # fmt: skip
+            _unknown_option(demo, key, opts)
         action = opts[key]
         if isinstance(value, bool) != (action.nargs == 0):
             kind = "true or false" if action.nargs == 0 else "a value"
@@ -122,18 +116,36 @@ def _check_case(demo: str, params: Mapping[str, Any], parser) -> None:
                              f"(a list of {action.nargs}), got {value!r}")  # fmt: skip
         values = value if isinstance(value, (list, tuple)) else [value]
         for v in values:
-            try:
-                converted = action.type(str(v)) if action.type is not None else str(v)
-            except (TypeError, ValueError) as exc:
-                kind = getattr(action.type, "__name__", "value")
-                raise StudyError(f"parameter {key!r} of {demo!r}: {v!r} is not a valid "
-                                 f"{kind}") from exc  # fmt: skip
-            if isinstance(v, str) and action.type in (int, float):
-                raise StudyError(f"parameter {key!r} of {demo!r}: {v!r} is text, not a number")
-            if action.choices is not None and converted not in action.choices:
-                raise StudyError(f"parameter {key!r} of {demo!r}: {v!r} is not one of "
-                                 f"{list(action.choices)}")  # fmt: skip
+            _check_value(demo, key, v, action)
     _check_ranges(demo, params, parser)
+
+
+def _unknown_option(demo: str, key: str, opts: Mapping[str, Any]) -> None:
+    """Raise the :class:`StudyError` of a parameter ``key`` that is no option of ``demo``,
+    with the closest option's name as a hint."""
+    import difflib
+
+    known = sorted(k for k in opts if k not in ("json", "out", "quiet", "help"))
+    close = difflib.get_close_matches(key, known, n=1)
+    hint = f"; did you mean {close[0]!r}?" if close else ""
+    raise StudyError(f"parameter {key!r} is not an option of {demo!r}{hint} "
+                     f"(options: {known})")  # fmt: skip
+
+
+def _check_value(demo: str, key: str, v: Any, action) -> None:
+    """One value ``v`` of the parameter ``key``: converted by the option's type, a number
+    given as a number, one of the option's choices."""
+    try:
+        converted = action.type(str(v)) if action.type is not None else str(v)
+    except (TypeError, ValueError) as exc:
+        kind = getattr(action.type, "__name__", "value")
+        raise StudyError(f"parameter {key!r} of {demo!r}: {v!r} is not a valid "
+                         f"{kind}") from exc  # fmt: skip
+    if isinstance(v, str) and action.type in (int, float):
+        raise StudyError(f"parameter {key!r} of {demo!r}: {v!r} is text, not a number")
+    if action.choices is not None and converted not in action.choices:
+        raise StudyError(f"parameter {key!r} of {demo!r}: {v!r} is not one of "
+                         f"{list(action.choices)}")  # fmt: skip
 
 
 def _check_ranges(demo: str, params: Mapping[str, Any], parser) -> None:
@@ -156,22 +168,44 @@ def load_spec(spec: str | os.PathLike | Mapping[str, Any]) -> StudySpec:
         An unknown demo, an unknown parameter, a value of the wrong type or out of range (the
         key named), an empty study.
     """
-    if isinstance(spec, Mapping):
-        data = dict(spec)
-    else:
-        path = Path(spec)
-        try:
-            data = tomllib.loads(path.read_text(encoding="utf-8"))
-        except OSError as exc:
-            raise StudyError(f"cannot read the study file {str(path)!r}: {exc}") from exc
-        except tomllib.TOMLDecodeError as exc:
-            raise StudyError(f"study file {str(path)!r} is not valid TOML: {exc}") from exc
+    data = _read_spec(spec)
     unknown = sorted(set(data) - {"demo", "parameters", "cases"})
     if unknown:
         raise StudyError(f"unknown keys {unknown} in the study (keys: demo, parameters, cases)")
     demo = data.get("demo")
     if not isinstance(demo, str):
         raise StudyError(f'the study needs demo = "<name>" (one of {list(_demos())}), got {demo!r}')
+    cases = [Case(i, c) for i, c in enumerate(_combinations(data))]
+    if ":" in demo:
+        _resolve(demo)  # importable
+    elif demo not in _demos():
+        raise StudyError(f'demo {demo!r} is not one of {list(_demos())} (or "module:function")')
+    else:
+        parser = _subparser(demo)
+        for case in cases:
+            _check_case(demo, case.params, parser)
+    ids = [c.case_id for c in cases]
+    if len(set(ids)) != len(ids):
+        raise StudyError("the study has the same case twice")
+    return StudySpec(demo, cases, data)
+
+
+def _read_spec(spec: str | os.PathLike | Mapping[str, Any]) -> dict[str, Any]:
+    """The study as a dictionary: the mapping given, or the TOML file read."""
+    if isinstance(spec, Mapping):
+        return dict(spec)
+    path = Path(spec)
+    try:
+        return tomllib.loads(path.read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise StudyError(f"cannot read the study file {str(path)!r}: {exc}") from exc
+    except tomllib.TOMLDecodeError as exc:
+        raise StudyError(f"study file {str(path)!r} is not valid TOML: {exc}") from exc
+
+
+def _combinations(data: Mapping[str, Any]) -> list[dict[str, Any]]:
+    """The parameters of each case: the grid of the ``[parameters]`` given as lists (the
+    others fixed), then each of the ``[[cases]]`` over the fixed ones."""
     params = dict(data.get("parameters", {}))
     if not isinstance(params, dict):
         raise StudyError("[parameters] must be a table of option = value or [values]")
@@ -189,19 +223,7 @@ def load_spec(spec: str | os.PathLike | Mapping[str, Any]) -> StudySpec:
         for values in itertools.product(*(axes[k] for k in keys)):
             combos.append({**fixed, **dict(zip(keys, values))})
     combos += [{**fixed, **c} for c in explicit]
-    cases = [Case(i, c) for i, c in enumerate(combos)]
-    if ":" in demo:
-        _resolve(demo)  # importable
-    elif demo not in _demos():
-        raise StudyError(f'demo {demo!r} is not one of {list(_demos())} (or "module:function")')
-    else:
-        parser = _subparser(demo)
-        for case in cases:
-            _check_case(demo, case.params, parser)
-    ids = [c.case_id for c in cases]
-    if len(set(ids)) != len(ids):
-        raise StudyError("the study has the same case twice")
-    return StudySpec(demo, cases, data)
+    return combos
 
 
 def _is_pair(key: str, value: list) -> bool:
