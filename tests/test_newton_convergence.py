@@ -15,6 +15,7 @@ from __future__ import annotations
 import json
 from collections import defaultdict
 
+import numpy as np
 import pytest
 
 from arlequin.demos.plate_with_hole import run_plate_with_hole
@@ -129,6 +130,17 @@ def test_pressure_vessel_folder_has_history_and_newton_rows(tmp_path):
     assert max(n["crossings"]) > 0 and max(n["plastic_points"]) > 0  # it yields at 300 MPa
     files = json.loads((tmp_path / "results.json").read_text())["files"]["history"]
     assert files == {"history": "history.csv", "newton": "newton.csv"}
+    _coarse_von_mises_is_written(tmp_path, n_steps)
+
+
+def _coarse_von_mises_is_written(folder, frames: int) -> None:
+    """The coarse elastic model's series carries its von Mises stress, one frame a step."""
+    from arlequin.io import read_series
+
+    _mesh, series = read_series(folder / "fields" / "coarse.xdmf")
+    assert len(series) == frames
+    vm = series[-1][2]["von_mises"]
+    assert float(np.max(vm[0] if isinstance(vm, list) else vm)) > 0.0
 
 
 def _newton(folder, column):
@@ -153,6 +165,7 @@ def test_plate_folder_has_history_and_newton_rows(tmp_path):
         h["newton_iterations"][0]
     )
     assert set(n["step"]) <= set(h["step"])
+    _coarse_von_mises_is_written(tmp_path, SMALL_PLATE["steps"])  # first yield: no frame
 
 
 def test_a_resumed_run_writes_the_same_files(tmp_path, monkeypatch):

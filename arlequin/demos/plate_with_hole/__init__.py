@@ -34,7 +34,8 @@ history, Newton iterations, residuals, cuts, the quadrature points that crossed 
 surface in each iteration), ``newton.csv`` (per Newton iteration: residuals, crossings), the
 field series of each block
 (``fields/coarse.xdmf``, ``fields/patch0.xdmf``: displacement, α, the mediator's multipliers,
-ε̄p and the von Mises stress per cell, one frame a step), ``load_displacement.png`` and
+ε̄p and the von Mises stress per cell, the coarse model's von Mises stress, one frame a
+step), ``load_displacement.png`` and
 ``plastic_zone.png``.
 """
 

@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from ...io import ResultsFolder
+from ...problem.arlequin_problem import von_mises_of
 from ..adaptive_options import growth_title
 from .result import PlateWithHoleResult
 from .setup import PlateSetup
@@ -34,16 +35,22 @@ def _on_block_cells(setup: PlateSetup, values: np.ndarray) -> np.ndarray:
 
 
 def cell_fields(setup: PlateSetup) -> Callable[[Any], dict[str, dict[str, np.ndarray]]]:
-    """The cell data of a frame: the J2 model's ε̄p and von Mises stress, cell means."""
+    """The cell data of a frame: the J2 model's ε̄p and von Mises stress, and the coarse
+    elastic model's von Mises stress (where it has a patch over it), cell means."""
 
     def fields(solver: Any) -> dict[str, dict[str, np.ndarray]]:
         state = solver.states[setup.plastic_block][setup.plastic_term]
-        return {
+        out = {
             setup.plastic_block: {
                 "eqps": _on_block_cells(setup, np.asarray(state.eqps).mean(axis=1)),
                 "von_mises": _on_block_cells(setup, np.asarray(state.von_mises).mean(axis=1)),
             }
         }
+        if setup.plastic_block != "coarse":
+            u = solver.u[solver.system.dofmap["coarse"].slice]
+            stress = setup.problem.coarse.stress_at_quadrature(u)
+            out["coarse"] = {"von_mises": von_mises_of(stress).mean(axis=1)}
+        return out
 
     return fields
 

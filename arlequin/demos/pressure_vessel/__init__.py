@@ -18,7 +18,8 @@ converged step: load factor, pressure, plastic front, displacements, Newton iter
 residuals, cuts, the quadrature points that crossed the yield surface in each iteration),
 ``newton.csv`` (per Newton iteration: residuals, crossings), the field series
 ``fields/coarse.xdmf`` and ``fields/patch0.xdmf`` (displacement, α, the mediator's multipliers,
-ε̄p and the von Mises stress per cell, one frame a step), ``pressure_displacement.png`` and
+ε̄p and the von Mises stress per cell, the coarse model's von Mises stress, one frame a
+step), ``pressure_displacement.png`` and
 ``plastic_zone.png``.
 """
 

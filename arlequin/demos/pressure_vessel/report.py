@@ -11,6 +11,7 @@ import numpy as np
 
 from ...geometry.facets import cyclic_quad_faces
 from ...io import ResultsFolder
+from ...problem.arlequin_problem import von_mises_of
 from ..adaptive_options import growth_title
 from .hill import cylinder_limit_load, sphere_limit_load, sphere_outer_displacement
 from .measures import von_mises
@@ -20,6 +21,7 @@ from .setup import VesselSetup
 __all__ = [
     "AdaptationPictures",
     "cell_fields",
+    "coarse_von_mises",
     "plane_polygons",
     "plot_patch_size",
     "plot_plastic_zone",
@@ -29,18 +31,31 @@ __all__ = [
 
 
 def cell_fields(setup: VesselSetup) -> Callable[[Any], dict[str, dict[str, np.ndarray]]]:
-    """The cell data of a frame: the J2 model's ε̄p and von Mises stress, cell means."""
+    """The cell data of a frame: the J2 model's ε̄p and von Mises stress, and the coarse
+    elastic model's von Mises stress (where it has a patch over it), cell means."""
 
     def fields(solver: Any) -> dict[str, dict[str, np.ndarray]]:
         state = solver.states[setup.plastic_block][0]
-        return {
+        out = {
             setup.plastic_block: {
                 "eqps": np.asarray(state.eqps).mean(axis=1),
                 "von_mises": von_mises(state).mean(axis=1),
             }
         }
+        if setup.plastic_block != "coarse":
+            out["coarse"] = {"von_mises": coarse_von_mises(setup.problem.coarse, solver)}
+        return out
 
     return fields
+
+
+def coarse_von_mises(coarse: Any, solver: Any) -> np.ndarray:
+    """The von Mises stress (Pa) of the coarse elastic model at the solver's displacement,
+    cell means, shape (n_cells,): where it exceeds σy outside the patch, the patch is too
+    small (``max_coarse_yield_ratio``); over the patch it is the coarse model's elastic field,
+    not the material's (the patch's own ``von_mises`` is)."""
+    u = solver.u[solver.system.dofmap["coarse"].slice]
+    return von_mises_of(coarse.stress_at_quadrature(u)).mean(axis=1)
 
 
 def plot_pressure_curve(result: PressureVesselResult, config: dict, path: str) -> None:
