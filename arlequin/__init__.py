@@ -99,6 +99,7 @@ _cache_kernels_outside_the_package()
 from . import adapt
 from .adapt import AdaptivePatch, PatchLimitError
 from .contract import (
+    BandYieldWarning,
     CapabilityError,
     CoarseYieldWarning,
     ConstraintError,
@@ -127,6 +128,7 @@ __version__ = "0.1.0"
 __all__ = [
     "AdaptivePatch",
     "ArlequinProblem",
+    "BandYieldWarning",
     "CallableWeights",
     "CapabilityError",
     "CoarseYieldWarning",

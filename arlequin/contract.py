@@ -26,9 +26,8 @@ Optional capabilities are declared by implementing their protocol (checked with
     :class:`~arlequin.solvers.CriticalFraction` controller to follow a changing
     configuration.
 
-State at quadrature points is an immutable object returned by ``internal_force`` as a *trial*
-state and committed by the integrator only once the step is accepted; the model never mutates
-it, so that a step can be redone from the committed state.
+State at quadrature points is immutable: a *trial* state from ``internal_force``, committed by
+the integrator once the step is accepted (a step can be redone from the committed state).
 
 Constraints
 -----------
@@ -38,16 +37,13 @@ the constraint object holds only its configuration; its state lives in immutable
 (:class:`ConstraintState` between steps, :class:`ConstraintTrial` during a step's status
 iterations) that the integrator passes in and commits. See the protocol for the calling sequence.
 
-Sign convention (every constraint): the force a constraint exerts on the system is ``−Bᵀλ`` (N)
-with ``λ`` the multiplier reported by the integrators, as in the static saddle point
-``K u + Bᵀλ = f``.
+Sign convention: a constraint's force on the system is ``−Bᵀλ`` (N), ``λ`` the integrators'
+multiplier, as in the static saddle point ``K u + Bᵀλ = f``.
 
 Dof layout
 ----------
-Within a model, dofs are interleaved by node (scikit-fem's ``ElementVector`` ordering),
-``local dof = n_components * node + component`` (:func:`node_dofs`); a coupled system stacks
-the models' dof vectors in blocks (:class:`arlequin.dofs.DofMap`).
-
+Within a model, dofs are interleaved by node, ``n_components * node + component``
+(:func:`node_dofs`); a coupled system stacks them in blocks (:class:`arlequin.dofs.DofMap`).
 Units are SI throughout (m, kg, s, Pa, N, J).
 """
 
@@ -61,6 +57,7 @@ import scipy.sparse as sp
 
 __all__ = [
     "CAPABILITIES",
+    "BandYieldWarning",
     "CapabilityError",
     "CellStates",
     "CoarseYieldWarning",
@@ -97,8 +94,7 @@ class StateError(ValueError):
     """A model's state became invalid during a run (an inverted cell, a failed return mapping).
 
     Models raise subclasses of it from ``internal_force``; the integrators turn it into a
-    :class:`SimulationError` naming the step and the time, and keep what was recorded until then.
-    """
+    :class:`SimulationError` naming the step and the time, keeping what was recorded."""
 
 
 class SimulationError(ValueError):
@@ -122,9 +118,13 @@ class SimulationError(ValueError):
 
 
 class CoarseYieldWarning(UserWarning):
-    """A coarse (linear-elastic) model carries von Mises stresses above the yield stress of its
-    patches' material outside the patches: the plastic zone has outgrown them, and the results
-    past that load are not those of the elastoplastic material."""
+    """A coarse elastic model carries von Mises stresses above its patches' yield stress
+    outside them: the plastic zone has outgrown the patches."""
+
+
+class BandYieldWarning(UserWarning):
+    """A patch yields in its gluing band, where its fields are the coupling's: its plastic zone
+    reached the band (widen the patch) or the mediator concentrates strain there."""
 
 
 class ConstraintError(ValueError):

@@ -21,7 +21,7 @@ from .fields import scalar_at_quadrature
 if TYPE_CHECKING:
     from .gluing import PatchCoupling
 
-__all__ = ["ExactnessWarning", "exactness_failures"]
+__all__ = ["ExactnessWarning", "exactness_failures", "unheld_band_cells"]
 
 logger = logging.getLogger(__name__)
 
@@ -34,17 +34,61 @@ class ExactnessWarning(UserWarning):
 def exactness_failures(pc: PatchCoupling) -> list[str]:
     """The exactness conditions of docs/theory.md this patch breaks ([] if none).
 
+    First, band cells the mediator does not hold (:func:`_unheld_cells`); then the uniform
+    stress conditions:
+
     Condition A: a nested patch with the fine mediator (whose space contains the coarse one
     on S_g), weights constant outside S_g. Condition B: ramp weights whose gradient ∇α_c is
     one constant vector over the part of S_g each mediator function sees (straight bands,
     no function meeting two bands), so that σ·∇α_c lies in the mediator space. User weights
     are not checked (logged).
     """
+    return _unheld_cells(pc) + _uniform_stress_failures(pc)
+
+
+def unheld_band_cells(pc: PatchCoupling) -> np.ndarray:
+    """Patch cells of the gluing band that their own weight does not hold: nodal weights with
+    α_fine = 0 at every vertex (a nested tetrahedral patch's staircase edge), shape (n,) int.
+
+    Such cells carry no stiffness; the coarse mediator constrains only the coarse-scale part
+    of the band's patch field, so under it their fine-scale modes deform freely under the
+    multipliers' forces (docs/theory.md, "The band's fine-scale modes"). The fine mediator
+    holds every patch dof of the band.
+    """
+    if pc.weights.mode != "nodal":
+        return np.zeros(0, dtype=np.int64)
+    fmesh = pc.fine_model.mesh
+    band = np.zeros(fmesh.nelements, dtype=bool)
+    band[pc.overlap.fine_cells[pc.gluing_cells]] = True
+    held = np.any(pc._fine_nodal("fine")[fmesh.t] > 0.0, axis=0)
+    return np.nonzero(band & ~held)[0]
+
+
+def _unheld_cells(pc: PatchCoupling) -> list[str]:
+    """The warning for :func:`unheld_band_cells` under the coarse mediator."""
+    if pc.mediator != "coarse":
+        return []
+    unheld = unheld_band_cells(pc)
+    if unheld.size == 0:
+        return []
+    fmesh = pc.fine_model.mesh
+    x = ", ".join(f"{c:.4g}" for c in fmesh.p[:, fmesh.t[:, unheld[0]]].mean(axis=1))
+    return [
+        f"{unheld.size} patch cell(s) of the gluing band have α_fine = 0 at every vertex (the "
+        f"first at x = ({x}) m) and the coarse mediator does not hold their fine-scale modes: "
+        "they deform freely under the multipliers (a plastic patch yields there, measured 12 "
+        "to 90 times the single fine mesh's plastic strain); use mediator='fine' (what the "
+        "default 'auto' takes here) or weights whose α_fine is positive on every band cell"
+    ]
+
+
+def _uniform_stress_failures(pc: PatchCoupling) -> list[str]:
+    """Conditions A and B of docs/theory.md §3 (a uniform stress reproduced exactly)."""
     nested = pc.overlap.method == "nested"
     same_space = (
         nested and pc.fine_model.mesh.nelements == np.unique(pc.overlap.coarse_cells).size
     )  # the patch is the coarse mesh itself: both mediators are the fine space
-    fine_mediator = pc.patch.mediator == "fine" or same_space
+    fine_mediator = pc.mediator == "fine" or same_space
     if nested and fine_mediator:
         return []  # condition A
     name = type(pc.weights).__name__
@@ -74,7 +118,7 @@ def _ramp_failures(pc: PatchCoupling) -> list[str]:
     scale = float(np.max(np.abs(grad))) if grad.size else 0.0
     if scale == 0.0:
         return []
-    coarse = pc.patch.mediator == "coarse"
+    coarse = pc.mediator == "coarse"
     owner = pc.overlap.coarse_cells[cells] if coarse else pc.overlap.fine_cells[cells]
     mesh = pc.coarse_model.mesh if coarse else pc.fine_model.mesh
     nodes = mesh.t[:, owner]  # (n_v, n_gc): the mediator functions over each gluing cell

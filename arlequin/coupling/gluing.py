@@ -21,11 +21,11 @@ import scipy.sparse as sp
 
 from ..geometry.facets import distance_to_facets, facet_coordinates, outward_normals
 from ..geometry.locate import cell_centroids, cell_sizes, locate_points
-from .exactness import ExactnessWarning, exactness_failures
+from .exactness import ExactnessWarning, exactness_failures, unheld_band_cells
 from .fields import scalar_at_quadrature
 from .mediators import CouplingMatrices, MediatorError, coupling_matrices
 from .overlap import Overlap, build_overlap, check_meshes
-from .patches import Patch
+from .patches import Patch, resolve_mediator
 from .weights import PartitionWeights, check_partition_of_unity
 
 __all__ = [
@@ -80,6 +80,8 @@ class PatchCoupling:
             )
         self.integration_model = coarse_model.with_mesh(self.overlap.integration_mesh)
         self._evaluate_weights()
+        #: the mediator space in use, "coarse" or "fine" (``patch.mediator`` resolved)
+        self.mediator = resolve_mediator(patch.mediator, unheld_band_cells(self).size)
         length = patch.length if patch.length is not None else self.default_h1_length()
         self.coupling: CouplingMatrices = coupling_matrices(
             self.overlap,
@@ -87,7 +89,7 @@ class PatchCoupling:
             self.n_components,
             patch.coupling,
             length,
-            patch.mediator,
+            self.mediator,
             self.axisymmetric,
         )
         self.exactness_failures = exactness_failures(self)

@@ -22,6 +22,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..contract import ContractError, Model, check_protocol
+from ..coupling.band_plasticity import BandPlasticity, band_plasticity
 from ..coupling.gluing import Patch, PatchCoupling
 from ..coupling.overlap import OverlapError
 from ..dofs import DofMap
@@ -73,18 +74,21 @@ class ArlequinProblem:
         The model of the whole structure.
     patches : sequence of Patch
         Non-overlapping refined patches.
-    mediator_dirichlet : {"keep", "drop"}
+    mediator_dirichlet : {"auto", "keep", "drop"}
         ``"drop"``: remove the mediator functions carried by dofs that a Dirichlet condition of
         the carrier model (the coarse one for a coarse mediator, the patch for a fine one)
         prescribes, so that the multiplier space is the trace of the constrained spaces. Use it
-        when both models carry the same condition in the gluing zone (a symmetry axis through
+        when both models carry the same condition in the gluing zone (a symmetry plane through
         the band): the rows would otherwise repeat the conditions (exactly so with a fine
-        mediator: linearly dependent rows) and carry their reactions. Default ``"keep"``.
+        mediator: linearly dependent rows, whose multipliers drift in the null direction, to
+        1e14 on a thick sphere, and load the supports with spurious reactions) and carry
+        their reactions. ``"auto"`` (default): ``"drop"`` for the patches glued by the fine
+        mediator, ``"keep"`` for the coarse one.
     """
 
     coarse: Any
     patches: Sequence[Patch] = field(default_factory=list)
-    mediator_dirichlet: str = "keep"
+    mediator_dirichlet: str = "auto"
 
     def __post_init__(self) -> None:
         check_protocol(self.coarse, Model, "the coarse model")
@@ -102,9 +106,10 @@ class ArlequinProblem:
         if len(set(self._names)) != len(self._names):
             raise ValueError(f"block names must be unique, got {self._names}")
         self._check_patches_disjoint()
-        if self.mediator_dirichlet not in ("keep", "drop"):
+        if self.mediator_dirichlet not in ("auto", "keep", "drop"):
             raise ValueError(
-                f"mediator_dirichlet must be 'keep' or 'drop', got {self.mediator_dirichlet!r}"
+                "mediator_dirichlet must be 'auto', 'keep' or 'drop', got "
+                f"{self.mediator_dirichlet!r}"
             )
 
     # ------------------------------------------------------------------ set-up
@@ -421,11 +426,19 @@ class ArlequinProblem:
         vm = von_mises_of(stress(u[self.dofmap()["coarse"].slice])[:, :, outside])
         return float(vm.max() / min(yields))
 
+    def band_plasticity(self, states: dict[str, list[Any]]) -> list[BandPlasticity]:
+        """Plastic flow in each J2 patch's gluing band for the blocks' ``states`` (name -> the
+        terms' states): :func:`arlequin.coupling.band_plasticity.band_plasticity` of every
+        patch whose model tells its plastic strain."""
+        bands = (band_plasticity(pc, (states.get(pc.name) or [None])[0]) for pc in self.couplings)
+        return [band for band in bands if band is not None]
+
     def mediator_rows(self, pc: PatchCoupling) -> np.ndarray:
         """Boolean mask of the mediator functions of ``pc`` kept as coupling rows (all of them,
-        unless ``mediator_dirichlet="drop"``)."""
+        unless ``mediator_dirichlet="drop"``, or ``"auto"`` with the fine mediator)."""
         dofs = np.asarray(pc.coupling.mediator_dofs)
-        if self.mediator_dirichlet == "keep":
+        mode = self.mediator_dirichlet
+        if mode == "keep" or (mode == "auto" and pc.coupling.mediator == "coarse"):
             return np.ones(dofs.size, dtype=bool)
         carrier = "coarse" if pc.coupling.mediator == "coarse" else pc.name
         model = self.model(carrier)

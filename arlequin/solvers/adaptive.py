@@ -27,6 +27,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..contract import SimulationError
+from .yield_watch import BandYieldWatch
 
 __all__ = ["AdaptableSolver", "run_adaptive"]
 
@@ -103,8 +104,8 @@ def _grow(solver: Any, adapt: Any, growth: Any, step: int, listeners: Sequence[A
             hook(solver, adapt)
 
 
-def _finish(solver: Any, adapt: Any, message: str | None = None) -> Any:
-    result = solver.result(message)
+def _finish(solver: Any, adapt: Any, watch: BandYieldWatch, message: str | None = None) -> Any:
+    result = watch.finish(solver.result(message))
     result.adaptations = list(adapt.records)
     result.max_coarse_yield_ratio = float(adapt.max_coarse_yield_ratio)
     result.problem = adapt.problem
@@ -123,7 +124,9 @@ def run_adaptive(
     Returns
     -------
     QuasiStaticResult
-        With ``adaptations``, ``max_coarse_yield_ratio`` and the final ``problem``.
+        With ``adaptations``, ``max_coarse_yield_ratio``, ``band_plastic_fraction`` (the
+        accepted steps' gluing bands, :class:`~arlequin.solvers.yield_watch.BandYieldWatch`)
+        and the final ``problem``.
 
     Raises
     ------
@@ -132,6 +135,7 @@ def run_adaptive(
         cap (:class:`~arlequin.problem.adapt.PatchLimitError`); ``err.result`` holds every
         converged step.
     """
+    watch = BandYieldWatch(lambda: adapt.problem)
     while solver.status == "running":
         snap = solver.snapshot()
         try:
@@ -146,15 +150,16 @@ def run_adaptive(
                 solver.restore(snap)
                 _grow(solver, adapt, growth, step, on_step, discarded)
                 continue
+            watch(solver)
             for listener in on_step:
                 listener(solver)
             # a growth for the next step: none after the last (its state was accepted)
             if growth is not None and solver.status == "running":
                 _grow(solver, adapt, growth, step, on_step)
         except SimulationError as err:
-            err.result = _finish(solver, adapt, str(err))
+            err.result = _finish(solver, adapt, watch, str(err))
             raise
         if callback is not None and callback(solver):
             solver.status = "stopped"
-            return _finish(solver, adapt, f"stopped by the callback at λ = {solver.t:.6g}")
-    return _finish(solver, adapt)
+            return _finish(solver, adapt, watch, f"stopped by the callback at λ = {solver.t:.6g}")
+    return _finish(solver, adapt, watch)

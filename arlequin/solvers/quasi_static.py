@@ -28,13 +28,10 @@ only the nonlinear blocks and the multipliers. The factorisations use a sparse d
 (``linear_solver``: SuperLU, or PARDISO where pypardiso is installed, which keeps its symbolic
 analysis from one iteration of a load step to the next: :mod:`arlequin.solvers.direct`).
 
-Timings: the solver adds up, over its load steps (failed attempts included), the wall time of
-the models' internal forces, return maps and tangent assembly, of the factorisations, of the
-solves, and the rest (residuals, line search, the condensation's products): a few
-``time.perf_counter`` calls a Newton iteration, in :attr:`QuasiStaticSolver.timings` and the
-result's ``timings``.
-
-Units: SI (λ dimensionless, displacements m, forces N).
+Timings (failed attempts included): the models' internal forces, return maps and tangents, the
+factorisations, the solves, the rest, in :attr:`QuasiStaticSolver.timings` and the result's.
+After each converged step the coarse models' stress outside the patches and the patches'
+gluing bands are watched (``CoarseYieldWarning``, ``BandYieldWarning``). Units: SI.
 """
 
 from __future__ import annotations
@@ -62,6 +59,7 @@ from .quasi_static_result import (
     QuasiStaticResult,
     QuasiStaticStep,
 )
+from .yield_watch import BandYieldWatch
 
 __all__ = [
     "STATUSES",
@@ -581,19 +579,21 @@ def solve_quasi_static(
     solver = QuasiStaticSolver(problem, load=load, steps=steps, **options)
     if adapt is not None:
         return run_adaptive(solver, adapt, on_step, callback)
-    watch = CoarseYieldWatch(problem)
+    watch, band = CoarseYieldWatch(problem), BandYieldWatch(lambda: problem)
+    message = None
     while solver.status == "running":
         try:
             rec = solver.step()
         except NewtonError as err:
-            err.result = solver.result(str(err))
+            err.result = band.finish(solver.result(str(err)))
             raise
         if rec is None:  # a limit load
             break
         watch(solver)
+        band(solver)
         for listener in on_step:
             listener(solver)
         if callback is not None and callback(solver):
             solver.status = "stopped"
-            return watch.finish(solver.result(f"stopped by the callback at λ = {solver.t:.6g}"))
-    return watch.finish(solver.result())
+            message = f"stopped by the callback at λ = {solver.t:.6g}"
+    return band.finish(watch.finish(solver.result(message)))

@@ -217,6 +217,9 @@ class QuasiStaticResult:
     #: final problem
     adaptations: list[Any] = field(default_factory=list)
     max_coarse_yield_ratio: float | None = None
+    #: largest share of a J2 patch's gluing band that was plastic after a converged step
+    #: (None: no J2 patch watched; :class:`~arlequin.solvers.yield_watch.BandYieldWatch`)
+    band_plastic_fraction: float | None = None
     problem: Any = field(default=None, repr=False)
     linear_solver: str = "superlu"
     timings: dict[str, float] = field(default_factory=dict)

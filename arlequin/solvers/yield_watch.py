@@ -1,0 +1,73 @@
+"""The gluing bands watched for plastic flow over a run (the coupling's, not the material's).
+
+After each converged quasi-static step, or at each sample a dynamic run records, every J2
+patch's gluing band is measured (the problem's ``band_plasticity``,
+:func:`arlequin.coupling.band_plasticity.band_plasticity`):
+the first time a band yields the run warns (:class:`~arlequin.contract.BandYieldWarning`, with
+the load or time, the patch, the band's plastic share and the largest plastic strain there and
+where), and the largest share over the run is kept for the result (``band_plastic_fraction``).
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Callable
+from typing import Any
+
+from ..contract import BandYieldWarning
+
+__all__ = ["BandYieldWatch"]
+
+
+class BandYieldWatch:
+    """Plastic flow in the patches' gluing bands over a run.
+
+    Parameters
+    ----------
+    problem_of : callable
+        ``problem_of() -> problem``: the run's current problem (an adaptive run's grows); one
+        with ``band_plasticity(states)`` (an :class:`~arlequin.ArlequinProblem`) is watched.
+    when : str
+        What the run's clock is in the warning: ``"λ"`` (a load factor) or ``"t"`` (s).
+
+    Attributes
+    ----------
+    fraction : float or None
+        Largest share of a band's quadrature weight that was plastic at a check (None before
+        any check of a problem with a J2 patch).
+    worst : arlequin.coupling.band_plasticity.BandPlasticity or None
+        The band measure of that check.
+    """
+
+    def __init__(self, problem_of: Callable[[], Any], when: str = "λ") -> None:
+        self.problem_of, self.when = problem_of, when
+        self.fraction: float | None = None
+        self.worst: Any = None
+        self.warned = False
+
+    def __call__(self, solver: Any) -> None:
+        """Measure the bands at the solver's committed ``states`` (at its ``t``)."""
+        measure = getattr(self.problem_of(), "band_plasticity", None)
+        if not callable(measure):
+            return
+        for band in measure(solver.states):
+            if self.fraction is None or band.fraction > self.fraction:
+                self.fraction, self.worst = band.fraction, band
+            if band.fraction > 0.0 and not self.warned:
+                self.warned = True
+                x = ", ".join(f"{c:.4g}" for c in band.position)
+                warnings.warn(
+                    f"at {self.when} = {solver.t:.6g} {band.patch} yields in its gluing band "
+                    f"({band.fraction:.3g} of the band plastic, largest plastic strain "
+                    f"{band.peak:.3g} at x = ({x}) m): the band's fields are the coupling's, "
+                    "not the material's (widen the patch so that its plastic zone stays inside "
+                    "the band's inner edge, or use mediator='fine', exact on a nested patch)",
+                    BandYieldWarning,
+                    stacklevel=3,
+                )
+
+    def finish(self, result: Any) -> Any:
+        """``result`` with ``band_plastic_fraction`` (the largest share seen, None if nothing
+        was watched)."""
+        result.band_plastic_fraction = self.fraction
+        return result
