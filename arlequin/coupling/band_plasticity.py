@@ -24,7 +24,14 @@ import numpy as np
 if TYPE_CHECKING:
     from .gluing import PatchCoupling
 
-__all__ = ["BandPlasticity", "PlasticPeak", "band_plasticity", "largest_plastic_strain"]
+__all__ = [
+    "BandPlasticity",
+    "PlasticPeak",
+    "band_cells",
+    "band_plasticity",
+    "largest_plastic_strain",
+    "plastic_peak",
+]
 
 
 @dataclass(frozen=True)
@@ -119,13 +126,32 @@ def band_plasticity(pc: PatchCoupling, state: Any) -> BandPlasticity | None:
     return BandPlasticity(pc.name, fraction, float(in_band[cell, point]), x[:, cell, point].copy())
 
 
+def plastic_peak(model: Any, state: Any, band: np.ndarray | None = None) -> PlasticPeak | None:
+    """The largest equivalent plastic strain of ``model`` in ``state`` and where it lies.
+
+    Parameters
+    ----------
+    model : Any
+        A model with ``equivalent_plastic_strain(state)`` and ``quadrature_points()``.
+    state : Any
+        Its state.
+    band : ndarray of bool, shape (n_elems,), optional
+        The model's cells in a gluing band (:func:`band_cells`); None: no band (a single mesh).
+
+    Returns
+    -------
+    PlasticPeak or None
+        None for a model without plastic strain.
+    """
+    if _measures(model) is None or state is None:
+        return None
+    eqps = np.asarray(model.equivalent_plastic_strain(state))
+    cell, point = np.unravel_index(int(np.argmax(eqps)), eqps.shape)
+    x = np.asarray(model.quadrature_points())[:, cell, point].copy()
+    return PlasticPeak(float(eqps[cell, point]), x, bool(band is not None and band[cell]))
+
+
 def largest_plastic_strain(pc: PatchCoupling, state: Any) -> PlasticPeak | None:
     """The largest equivalent plastic strain of the patch of ``pc`` and whether it lies in the
     gluing band (None for a patch model without plastic strain)."""
-    measures = _measures(pc.fine_model)
-    if measures is None or state is None:
-        return None
-    eqps = np.asarray(measures[0](state))
-    cell, point = np.unravel_index(int(np.argmax(eqps)), eqps.shape)
-    x = np.asarray(pc.fine_model.quadrature_points())[:, cell, point].copy()
-    return PlasticPeak(float(eqps[cell, point]), x, bool(band_cells(pc)[cell]))
+    return plastic_peak(pc.fine_model, state, band_cells(pc))

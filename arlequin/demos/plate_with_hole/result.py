@@ -7,6 +7,7 @@ from typing import Any
 
 from ...io import JsonResult
 from ..adaptive_options import ADAPTATIONS_UNIT
+from ..plastic_report import PLASTIC_UNITS
 
 __all__ = ["HISTORY_KEYS", "JSON_KEYS", "UNITS", "PlateWithHoleResult"]
 
@@ -17,6 +18,7 @@ JSON_KEYS = ("history", "wall_time_s", "n_elements", "patch_fraction")
 HISTORY_KEYS = ("load", "displacement", "plastic_area", "plastic_extent", "newton_iterations",
                 "residuals", "patch_fraction")  # fmt: skip
 UNITS = {
+    **PLASTIC_UNITS,
     "load": "Pa",
     "displacement": "m",
     "plastic_area": "m^2",
@@ -81,6 +83,17 @@ class PlateWithHoleResult(JsonResult):
         ``gluing_rings`` coarse cells of the patch's interior boundary; None for mono and
         graded). Criterion 4 of issue 31 (the adaptive patch at most 1.5 times the plastic
         zone and its band) reads ``patch_fraction ≤ 1.5 (plastic_area / plate + band_fraction)``.
+    band_plastic_fraction : float or None
+        The largest share of the patch's gluing band (its quadrature weight) that was plastic
+        after a converged step (None for a single mesh): above 0 the run warns
+        (``BandYieldWarning``): the band's fields are the coupling's, not the material's.
+    max_plastic_strain : float or None
+        The final state's largest equivalent plastic strain of the J2 model (1).
+    max_plastic_strain_position : list of float or None
+        Its quadrature point (m, reference configuration).
+    max_plastic_strain_in_band : bool or None
+        Whether it lies in the patch's gluing band (None for a single mesh): if so, it is the
+        coupling's, not the material's.
     """
 
     history: dict[str, list[Any]]
@@ -95,6 +108,10 @@ class PlateWithHoleResult(JsonResult):
     max_coarse_yield_ratio: float | None = None
     plastic_cover_fraction: float | None = None
     band_fraction: float | None = None
+    band_plastic_fraction: float | None = None
+    max_plastic_strain: float | None = None
+    max_plastic_strain_position: list[float] | None = None
+    max_plastic_strain_in_band: bool | None = None
 
     json_exclude = ("config",)
 

@@ -11,12 +11,14 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ...contract import CoarseYieldWarning, SimulationError
+from ...contract import BandYieldWarning, CoarseYieldWarning, SimulationError
 from ...io import QuasiStaticRunWriter, ResultsFolder
 from ...problem.adapt import cell_rings
 from ...solvers import NewtonError, QuasiStaticSolver
 from ...solvers.adaptive import run_adaptive
+from ...solvers.yield_watch import BandYieldWatch
 from ..adaptive_options import fixed_patch
+from ..plastic_report import plastic_report
 from .result import HISTORY_KEYS, UNITS, PlateWithHoleResult
 from .setup import PlateSetup, area, build, loaded_edge_average
 
@@ -82,6 +84,9 @@ class _Recorder:
         self.history: dict[str, list[Any]] = {k: [] for k in HISTORY_KEYS}
         self.max_coarse_yield_ratio = 0.0
         self.adaptations: list[dict[str, Any]] = []
+        # the patch's gluing band after each accepted step (its warning: the run's own, at
+        # the end, with the figure)
+        self.band = BandYieldWatch(lambda: self.setup.problem)
 
     def on_adapt(self, solver: Any, adapt: Any) -> None:
         """The patch grew: follow its problem (the loaded edge's dofs, the J2 model)."""
@@ -110,6 +115,7 @@ class _Recorder:
         if s.plastic_block != "coarse":  # a coarse elastic model over a patch
             value = s.problem.coarse_yield_ratio(solver.u, self.config.yield_stress)
             self.max_coarse_yield_ratio = max(self.max_coarse_yield_ratio, value or 0.0)
+            self.band(solver)
 
     def last(self, solver: Any = None) -> dict[str, float]:
         """The measures of the last converged state (the columns of history.csv)."""
@@ -201,6 +207,7 @@ def run(config: PlateWithHoleConfig, out: str | None = None,
     try:
         with warnings.catch_warnings():  # the demo says it itself, with the run's figure
             warnings.simplefilter("ignore", CoarseYieldWarning)
+            warnings.simplefilter("ignore", BandYieldWarning)
             solver, lam0 = _steps(config, setup, system, recorder, listeners)
     except SimulationError as err:  # a Newton failure, the adaptive patch's cap
         if folder is not None:
@@ -213,6 +220,7 @@ def run(config: PlateWithHoleConfig, out: str | None = None,
             folder.finish("interrupted", "interrupted")
         raise
     qs = solver.result()
+    state = solver.states[setup.plastic_block][setup.plastic_term]
     result = PlateWithHoleResult(
         history=recorder.history,
         wall_time_s=time.perf_counter() - start,
@@ -224,10 +232,9 @@ def run(config: PlateWithHoleConfig, out: str | None = None,
         config=config.inputs(),
         adaptations=list(recorder.adaptations),
         max_coarse_yield_ratio=_coarse_ratio(setup, recorder),
-        plastic_cover_fraction=plastic_cover_fraction(
-            setup, solver.states[setup.plastic_block][setup.plastic_term].eqps, config.gluing_rings
-        ),
+        plastic_cover_fraction=plastic_cover_fraction(setup, state.eqps, config.gluing_rings),
         band_fraction=band_fraction(setup),
+        **plastic_report(setup.problem, setup.plastic_block, state, recorder.band.fraction),
     )
     if folder is not None:
         folder.add_results(result.to_json(), UNITS)
@@ -241,8 +248,21 @@ def run(config: PlateWithHoleConfig, out: str | None = None,
             CoarseYieldWarning,
             stacklevel=3,
         )
+    _warn_band(result)
     logger.info("%s", result.summary())
     return result
+
+
+def _warn_band(result: PlateWithHoleResult) -> None:
+    """The run's BandYieldWarning, with its figures, if the patch yielded in its band."""
+    if (result.band_plastic_fraction or 0.0) > 0.0:
+        warnings.warn(
+            f"the patch yielded in its gluing band ({result.band_plastic_fraction:.3g} of the "
+            "band plastic at the worst step): the band's fields are the coupling's, not the "
+            "material's (widen --patch-radius, or use --adaptive)",
+            BandYieldWarning,
+            stacklevel=3,
+        )
 
 
 def _listeners(setup: PlateSetup, system: Any, folder: ResultsFolder | None,

@@ -7,6 +7,7 @@ from typing import Any
 
 from ...io import JsonResult
 from ..adaptive_options import ADAPTATIONS_UNIT
+from ..plastic_report import PLASTIC_UNITS
 
 __all__ = ["HISTORY_KEYS", "JSON_KEYS", "UNITS", "PressureVesselResult"]
 
@@ -17,6 +18,7 @@ JSON_KEYS = ("first_yield_pressure", "limit_load_reached", "limit_load", "n_elem
 HISTORY_KEYS = ("pressure", "plastic_radius", "outer_displacement", "inner_displacement",
                 "newton_iterations", "residuals", "patch_fraction")  # fmt: skip
 UNITS = {
+    **PLASTIC_UNITS,
     "first_yield_pressure": "Pa",
     "limit_load": "Pa",
     "n_elements": "1",
@@ -75,6 +77,17 @@ class PressureVesselResult(JsonResult):
         The largest von Mises stress / σy of the coarse elastic model outside the patch over
         the run (0 for ``mono``); above 1 the run warns (``CoarseYieldWarning``): the plastic
         zone has outgrown the patch.
+    band_plastic_fraction : float or None
+        The largest share of the patch's gluing band (its quadrature weight) that was plastic
+        after a converged step (None for a single mesh): above 0 the run warns
+        (``BandYieldWarning``): the band's fields are the coupling's, not the material's.
+    max_plastic_strain : float or None
+        The final state's largest equivalent plastic strain of the J2 model (1).
+    max_plastic_strain_position : list of float or None
+        Its quadrature point (m, reference configuration).
+    max_plastic_strain_in_band : bool or None
+        Whether it lies in the patch's gluing band (None for a single mesh): if so, it is the
+        coupling's, not the material's.
     """
 
     first_yield_pressure: float
@@ -89,6 +102,10 @@ class PressureVesselResult(JsonResult):
     max_coarse_yield_ratio: float = 0.0
     config: dict[str, Any] = field(default_factory=dict)
     adaptations: list[dict[str, Any]] = field(default_factory=list)
+    band_plastic_fraction: float | None = None
+    max_plastic_strain: float | None = None
+    max_plastic_strain_position: list[float] | None = None
+    max_plastic_strain_in_band: bool | None = None
 
     json_exclude = ("config",)
 

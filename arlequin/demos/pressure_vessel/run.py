@@ -15,6 +15,7 @@ from ...contract import CoarseYieldWarning, SimulationError
 from ...io import QuasiStaticRunWriter, ResultsFolder, read_checkpoint, write_checkpoint
 from ...solvers import solve_quasi_static
 from ..adaptive_options import fixed_patch
+from ..plastic_report import plastic_report
 from .hill import (
     cylinder_first_yield,
     cylinder_limit_load,
@@ -299,6 +300,12 @@ def _result(config, setup, qs, recorder, first_yield, wall) -> PressureVesselRes
         config=config.inputs(),
         adaptations=[a.to_json() for a in qs.adaptations],
         max_coarse_yield_ratio=ratio,
+        **plastic_report(
+            qs.problem or setup.problem,
+            setup.plastic_block,
+            qs.states[setup.plastic_block][0],
+            qs.band_plastic_fraction,
+        ),
     )
     if ratio > 1.0:
         warnings.warn(

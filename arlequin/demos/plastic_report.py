@@ -1,0 +1,37 @@
+"""What the quasi-static J2 demos report of their plastic zone's peak and gluing band.
+
+A J2 patch's largest plastic strain is the quantity a plasticity study reports first; it means
+something only outside the gluing band, where the patch's fields are the material's. The demos
+record it with its place and whether it lies in the band (``max_plastic_strain``,
+``max_plastic_strain_position``, ``max_plastic_strain_in_band``), and the band's plastic share
+over the run (``band_plastic_fraction``, :class:`~arlequin.solvers.yield_watch.BandYieldWatch`).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+__all__ = ["PLASTIC_UNITS", "plastic_report"]
+
+#: The units of :func:`plastic_report`'s keys.
+PLASTIC_UNITS = {
+    "band_plastic_fraction": "1",
+    "max_plastic_strain": "1",
+    "max_plastic_strain_position": "m",
+    "max_plastic_strain_in_band": "",
+}
+
+
+def plastic_report(problem: Any, block: str, state: Any,
+                   band_fraction: float | None) -> dict[str, Any]:  # fmt: skip
+    """The JSON keys of :data:`PLASTIC_UNITS` for the J2 model of ``block`` in its final
+    ``state`` (``problem.plastic_peak``) and the band's largest plastic share over the run
+    (None without a patch: a single mesh, or a graded one)."""
+    peak = problem.plastic_peak(block, state)
+    patch = block != "coarse"
+    return {
+        "band_plastic_fraction": band_fraction if patch else None,
+        "max_plastic_strain": None if peak is None else peak.value,
+        "max_plastic_strain_position": None if peak is None else peak.position.tolist(),
+        "max_plastic_strain_in_band": peak.in_band if (peak is not None and patch) else None,
+    }
