@@ -10,7 +10,7 @@ checks them on a built :class:`~arlequin.coupling.gluing.PatchCoupling`; the cou
 from __future__ import annotations
 
 import logging
-from typing import TYPE_CHECKING
+from typing import Any, Protocol
 
 import numpy as np
 from skfem import Basis
@@ -18,10 +18,24 @@ from skfem import Basis
 from ..geometry.reference import scalar_element_for
 from .fields import scalar_at_quadrature
 
-if TYPE_CHECKING:
-    from .gluing import PatchCoupling
+__all__ = ["ExactnessWarning", "GluedPatch", "exactness_failures", "unheld_band_cells"]
 
-__all__ = ["ExactnessWarning", "exactness_failures", "unheld_band_cells"]
+
+class GluedPatch(Protocol):
+    """What the checks read of a patch's coupling: a built
+    :class:`~arlequin.coupling.gluing.PatchCoupling` (whose module imports this one, so the
+    checks name its members, not its class)."""
+
+    name: str
+    mediator: str
+    overlap: Any
+    coarse_model: Any
+    fine_model: Any
+    weights: Any
+    gluing_cells: np.ndarray
+
+    def _fine_nodal(self, which: str) -> np.ndarray: ...
+
 
 logger = logging.getLogger(__name__)
 
@@ -31,7 +45,7 @@ class ExactnessWarning(UserWarning):
     reproduced exactly (the message names the condition and a setting that meets it)."""
 
 
-def exactness_failures(pc: PatchCoupling) -> list[str]:
+def exactness_failures(pc: GluedPatch) -> list[str]:
     """The exactness conditions of docs/theory.md this patch breaks ([] if none).
 
     First, band cells the mediator does not hold (:func:`_unheld_cells`); then the uniform
@@ -46,7 +60,7 @@ def exactness_failures(pc: PatchCoupling) -> list[str]:
     return _unheld_cells(pc) + _uniform_stress_failures(pc)
 
 
-def unheld_band_cells(pc: PatchCoupling) -> np.ndarray:
+def unheld_band_cells(pc: GluedPatch) -> np.ndarray:
     """Patch cells of the gluing band that their own weight does not hold: nodal weights with
     α_fine = 0 at every vertex (a nested tetrahedral patch's staircase edge), shape (n,) int.
 
@@ -64,7 +78,7 @@ def unheld_band_cells(pc: PatchCoupling) -> np.ndarray:
     return np.nonzero(band & ~held)[0]
 
 
-def _unheld_cells(pc: PatchCoupling) -> list[str]:
+def _unheld_cells(pc: GluedPatch) -> list[str]:
     """The warning for :func:`unheld_band_cells` under the coarse mediator."""
     if pc.mediator != "coarse":
         return []
@@ -82,7 +96,7 @@ def _unheld_cells(pc: PatchCoupling) -> list[str]:
     ]
 
 
-def _uniform_stress_failures(pc: PatchCoupling) -> list[str]:
+def _uniform_stress_failures(pc: GluedPatch) -> list[str]:
     """Conditions A and B of docs/theory.md §3 (a uniform stress reproduced exactly)."""
     nested = pc.overlap.method == "nested"
     same_space = (
@@ -105,7 +119,7 @@ def _uniform_stress_failures(pc: PatchCoupling) -> list[str]:
     return _ramp_failures(pc)
 
 
-def _ramp_failures(pc: PatchCoupling) -> list[str]:
+def _ramp_failures(pc: GluedPatch) -> list[str]:
     """Condition B for ramp weights: one weight gradient per mediator function."""
     imesh = pc.overlap.integration_mesh
     cells = pc.gluing_cells

@@ -14,6 +14,10 @@ command line needs them, its flag, choices or mutually exclusive group. From it 
 Its ``check`` method validates the inputs when the configuration is made, so a bad value is a
 ``ValueError`` naming the quantity and its value before any work, whether the configuration
 comes from the command line, a study file or Python.
+
+A configuration runs through the runner its demo's package registers (:func:`register_runner`,
+in the package's ``__init__.py``): the configuration never imports its own run module, which
+imports it.
 """
 
 from __future__ import annotations
@@ -27,10 +31,13 @@ from typing import Any, ClassVar
 __all__ = [
     "DemoConfig",
     "Option",
+    "Runner",
     "check_choice",
     "check_positive",
     "check_range",
     "option",
+    "register_runner",
+    "runner_of",
 ]
 
 
@@ -146,8 +153,12 @@ class DemoConfig:
     def run(self, out: str | None = None, progress: Callable[[float], None] | None = None) -> Any:
         """Run the demo (``out``: a results folder; ``progress``: called with the progress in
         the unit of :meth:`progress_scale`); returns its result (``summary()``,
-        ``to_json()``)."""
-        raise NotImplementedError(f"{type(self).__name__}.run")
+        ``to_json()``). Runs the ``run`` of the runner registered for the configuration's
+        class (:func:`register_runner`); a demo in one module may override this method."""
+        runner = runner_of(type(self))
+        if runner is None:
+            raise NotImplementedError(f"{type(self).__name__}.run")
+        return runner.run(self, out=out, progress=progress)
 
     def progress_scale(self) -> tuple[float, str, float, str]:
         """The progress bar: ``(total, unit, scale, label)``; ``run`` reports ``x`` shown as
@@ -161,8 +172,11 @@ class DemoConfig:
     @classmethod
     def resume(cls, out: str, progress: Callable[[float], None] | None = None) -> Any:
         """Continue the interrupted run whose checkpoint is in ``out`` (the demos with a
-        ``--resume`` switch)."""
-        raise NotImplementedError(f"{cls.__name__}.resume")
+        ``--resume`` switch): the ``resume`` of the registered runner."""
+        runner = runner_of(cls)
+        if runner is None or runner.resume is None:
+            raise NotImplementedError(f"{cls.__name__}.resume")
+        return runner.resume(out, progress=progress)
 
     @classmethod
     def resume_progress_scale(cls, out: str) -> tuple[float, str, float, str]:
@@ -172,6 +186,39 @@ class DemoConfig:
     def replace(self, **changes: Any) -> DemoConfig:
         """A copy with some parameters changed (checked again)."""
         return dataclasses.replace(self, **changes)
+
+
+@dataclass(frozen=True)
+class Runner:
+    """How a demo's configuration runs: ``run(config, out=, progress=)`` returning its result
+    and, for the demos with ``--resume``, ``resume(out, progress=)``."""
+
+    run: Callable[..., Any]
+    resume: Callable[..., Any] | None = None
+
+
+#: Configuration class -> its runner, filled by the demos' packages (:func:`register_runner`).
+RUNNERS: dict[type, Runner] = {}
+
+
+def register_runner(
+    config: type[DemoConfig], run: Callable[..., Any], resume: Callable[..., Any] | None = None
+) -> None:
+    """Register how the configurations of class ``config`` run (:class:`Runner`): called by
+    the demo's package (its ``__init__.py``, which imports both the configuration and the run
+    module), so that :meth:`DemoConfig.run` and :meth:`DemoConfig.resume` reach the run module
+    without the configuration importing it."""
+    RUNNERS[config] = Runner(run, resume)
+
+
+def runner_of(config: type[DemoConfig]) -> Runner | None:
+    """The runner registered for ``config`` or, failing that, for the nearest of its bases
+    (None if none)."""
+    for cls in config.__mro__:
+        runner = RUNNERS.get(cls)
+        if runner is not None:
+            return runner
+    return None
 
 
 def _plain(value: Any) -> Any:

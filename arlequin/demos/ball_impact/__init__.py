@@ -47,6 +47,8 @@ run records per step), :mod:`~.result` (:class:`BallImpactResult`, its keys and 
 solution) and :mod:`~.report` (the results folder's files and picture).
 """
 
+from ..config import register_runner
+from . import run as _run
 from .api import run_ball_impact
 from .config import COPPER, DEFAULT_STEP_RATIO, MODELS, REGIMES, STEEL, BallImpactConfig
 from .result import JSON_KEYS, BallImpactResult, hertz
@@ -65,3 +67,6 @@ __all__ = [
     "hertz",
     "run_ball_impact",
 ]
+
+# the configuration runs through its package's runner (it does not import its run module)
+register_runner(BallImpactConfig, _run.run_config)

@@ -15,10 +15,8 @@ from __future__ import annotations
 import dataclasses
 import logging
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
-from pathlib import Path
 from typing import Any, ClassVar
 
 from ...models import IsotropicElastic, J2Material
@@ -32,7 +30,7 @@ from ..adaptive_options import (
     max_patch_fraction_option,
 )
 from ..config import DemoConfig, _plain, check_choice, option
-from .result import INPUT_UNITS, BallImpactResult, hertz
+from .result import INPUT_UNITS, hertz
 from .setup import BallSizes, ResolvedInputs, ball_sizes, mono_cells
 
 __all__ = [
@@ -423,13 +421,6 @@ class BallImpactConfig(DemoConfig):
         return dict(INPUT_UNITS)
 
     # -- running ----------------------------------------------------------------------------
-    def run(self, out: str | Path | None = None,
-            progress: Callable[[float], None] | None = None) -> BallImpactResult:  # fmt: skip
-        """Run the impact (:func:`arlequin.demos.ball_impact.run.run_config`)."""
-        from .run import run_config
-
-        return run_config(self, out=out, progress=progress)
-
     def progress_scale(self) -> tuple[float, str, float, str]:
         """The progress bar: the fraction of the simulated time, in percent."""
         return 100.0, "%", 100.0, "ball impact"

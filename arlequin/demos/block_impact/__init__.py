@@ -10,8 +10,14 @@ Modules: :mod:`.config` (``BlockImpactConfig``), :mod:`.setup`, :mod:`.run`
 (``run_block_impact``) and :mod:`.result` (``BlockImpactResult``).
 """
 
+from ..config import register_runner
+from . import run as _run
 from .api import run_block_impact
 from .config import BlockImpactConfig
 from .result import BlockImpactResult
 
 __all__ = ["BlockImpactConfig", "BlockImpactResult", "run_block_impact"]
+
+# the configuration runs through its package's runner (it does not import its run module);
+# no results folder, no progress
+register_runner(BlockImpactConfig, lambda config, out=None, progress=None: _run.run_config(config))

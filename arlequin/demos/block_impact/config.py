@@ -2,10 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
-from pathlib import Path
-from typing import Any
 
 from ..config import DemoConfig, option
 
@@ -39,12 +36,3 @@ class BlockImpactConfig(DemoConfig):
             raise ValueError(f"dim must be 2 or 3, got {self.dim}")
         if self.target not in ("plane", "block"):
             raise ValueError(f"target must be 'plane' or 'block', got {self.target!r}")
-
-    def run(
-        self, out: str | Path | None = None, progress: Callable[[float], None] | None = None
-    ) -> Any:
-        """The impact (no results folder: ``out`` and ``progress`` are not used); returns its
-        :class:`~arlequin.demos.block_impact.BlockImpactResult`."""
-        from .run import run_config
-
-        return run_config(self)

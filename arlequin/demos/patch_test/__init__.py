@@ -14,6 +14,8 @@ Modules: :mod:`.config` (``PatchTestConfig``, the ``arlequin patch-test`` option
 :mod:`.report` (the results folder and the error picture).
 """
 
+from ..config import register_runner
+from . import run as _run
 from .api import build_patch_test_problem, run_patch_test
 from .config import DIMS, LAYOUTS, PatchTestConfig
 from .report import plot_patch_test_error
@@ -28,3 +30,9 @@ __all__ = [
     "plot_patch_test_error",
     "run_patch_test",
 ]
+
+# the configuration runs through its package's runner (it does not import its run module);
+# one static solve, no progress
+register_runner(
+    PatchTestConfig, lambda config, out=None, progress=None: _run.run_config(config, out)
+)

@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any, ClassVar
 
 from ..config import DemoConfig, check_choice, option
@@ -82,12 +80,3 @@ class PatchTestConfig(DemoConfig):
                 )
             _positive_int("ratio", self.ratio)
             _positive_int("band_cells", self.band_cells)
-
-    def run(
-        self, out: str | Path | None = None, progress: Callable[[float], None] | None = None
-    ) -> Any:
-        """Solve the patch test (``progress`` unused: one static solve); returns its
-        :class:`~arlequin.demos.patch_test.PatchTestResult`."""
-        from .run import run_config
-
-        return run_config(self, out)

@@ -39,6 +39,8 @@ step), ``load_displacement.png`` and
 ``plastic_zone.png``.
 """
 
+from ..config import register_runner
+from . import run as _run
 from .config import DEFAULT_LOAD, PlateWithHoleConfig
 from .result import HISTORY_KEYS, JSON_KEYS, PlateWithHoleResult
 
@@ -50,6 +52,9 @@ __all__ = [
     "PlateWithHoleResult",
     "run_plate_with_hole",
 ]
+
+# the configuration runs through its package's runner (it does not import its run module)
+register_runner(PlateWithHoleConfig, _run.run)
 
 
 def run_plate_with_hole(out=None, progress=None, **options) -> PlateWithHoleResult:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
@@ -189,7 +188,3 @@ class PlateWithHoleConfig(DemoConfig):
         return 100.0, "%", 100.0, f"{self.command} ({self.model})"
 
     # -- running -----------------------------------------------------------------------------
-    def run(self, out: str | None = None, progress: Callable[[float], None] | None = None) -> Any:
-        from .run import run
-
-        return run(self, out=out, progress=progress)

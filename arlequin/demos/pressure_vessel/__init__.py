@@ -23,6 +23,8 @@ step), ``pressure_displacement.png`` and
 ``plastic_zone.png``.
 """
 
+from ..config import register_runner
+from . import run as _run
 from .config import PressureVesselConfig
 from .hill import sphere_outer_displacement, sphere_plastic_radius
 from .result import JSON_KEYS, PressureVesselResult
@@ -35,6 +37,9 @@ __all__ = [
     "sphere_outer_displacement",
     "sphere_plastic_radius",
 ]
+
+# the configuration runs through its package's runner (it does not import its run module)
+register_runner(PressureVesselConfig, _run.run, resume=_run.resume)
 
 
 def run_pressure_vessel(out=None, progress=None, **options) -> PressureVesselResult:

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
@@ -196,22 +195,9 @@ class PressureVesselConfig(DemoConfig):
         return out
 
     # -- running -----------------------------------------------------------------------------
-    def run(self, out: str | None = None, progress: Callable[[float], None] | None = None) -> Any:
-        """Run the vessel (:func:`arlequin.demos.pressure_vessel.run.run`)."""
-        from .run import run
-
-        return run(self, out=out, progress=progress)
-
     def progress_scale(self) -> tuple[float, str, float, str]:
         """The bar shows the load factor in percent."""
         return 100.0, "% load", 100.0, self.command
-
-    @classmethod
-    def resume(cls, out: str, progress: Callable[[float], None] | None = None) -> Any:
-        """Continue the interrupted run of the results folder ``out`` from its checkpoint."""
-        from .run import resume
-
-        return resume(out, progress=progress)
 
     @classmethod
     def resume_progress_scale(cls, out: str) -> tuple[float, str, float, str]:

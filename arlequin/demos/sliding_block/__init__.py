@@ -53,6 +53,8 @@ record), sliding.csv (per step: mean velocity, slip velocity, works, fixed-point
 fields/block.xdmf, sliding_block.png. SI units.
 """
 
+from ..config import register_runner
+from . import run as _run
 from .api import run_sliding_block
 from .config import DAMPING, DEFAULT_PRESSURE, RAMP_TRANSITS, SlidingBlockConfig
 from .report import plot_sliding_block
@@ -72,3 +74,6 @@ __all__ = [
     "plot_sliding_block",
     "run_sliding_block",
 ]
+
+# the configuration runs through its package's runner (it does not import its run module)
+register_runner(SlidingBlockConfig, _run.run)

@@ -14,15 +14,13 @@ neither loading is given) and ``damping`` (:data:`DAMPING`); the resolved values
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
-from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from ..config import DemoConfig, check_positive, check_range, option
 
 if TYPE_CHECKING:
-    from .result import SlidingBlockResult
+    pass
 
 __all__ = ["DAMPING", "DEFAULT_PRESSURE", "RAMP_TRANSITS", "SlidingBlockConfig"]
 
@@ -213,13 +211,3 @@ class SlidingBlockConfig(DemoConfig):
         return data
 
     # -- running -----------------------------------------------------------------------------
-    def run(
-        self,
-        out: str | Path | None = None,
-        progress: Callable[[float], None] | None = None,
-    ) -> SlidingBlockResult:
-        """Run the sliding block (:func:`arlequin.demos.sliding_block.run.run`): ``out`` a
-        results folder, ``progress(fraction)`` of the simulated time."""
-        from .run import run
-
-        return run(self, out=out, progress=progress)

@@ -10,6 +10,8 @@ or a 3D quarter), :mod:`.record` (the history, the balance, the field frames), :
 :func:`resume_taylor_bar`).
 """
 
+from ..config import register_runner
+from . import run as _run
 from .api import resume_taylor_bar, run_taylor_bar
 from .config import TaylorBarConfig
 from .meshes import taylor_bar_mesh
@@ -38,3 +40,6 @@ __all__ = [
     "run_taylor_bar",
     "taylor_bar_mesh",
 ]
+
+# the configuration runs through its package's runner (it does not import its run module)
+register_runner(TaylorBarConfig, _run.run_config, resume=_run.resume_run)

@@ -9,13 +9,12 @@ mesh is built or anything written.
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import ClassVar
 
 from ..config import DemoConfig, option
 from .checkpoint import load_checkpoint
-from .result import GEOMETRIES, MODELS, TaylorBarResult
+from .result import GEOMETRIES, MODELS
 from .setup import resolve
 
 __all__ = ["TaylorBarConfig"]
@@ -325,23 +324,9 @@ class TaylorBarConfig(DemoConfig):
         names = ("voce_saturation", "voce_rate", "jc_b", "jc_n", "jc_c", "jc_reference_rate")
         return {k: getattr(self, k) for k in names if getattr(self, k) is not None}
 
-    def run(self, out: str | None = None,
-            progress: Callable[[float], None] | None = None) -> TaylorBarResult:  # fmt: skip
-        """Run the Taylor bar (``progress(t)`` with the simulated time t in s)."""
-        from .run import run_config
-
-        return run_config(self, out=out, progress=progress)
-
     def progress_scale(self) -> tuple[float, str, float, str]:
         """The progress bar in µs of simulated time."""
         return self.t_end * 1e6, "µs", 1e6, "simulated time"
-
-    @classmethod
-    def resume(cls, out: str, progress: Callable[[float], None] | None = None) -> Any:
-        """Continue the interrupted run of the folder ``out`` from its last checkpoint."""
-        from .run import resume_run
-
-        return resume_run(out, progress)
 
     @classmethod
     def resume_progress_scale(cls, out: str) -> tuple[float, str, float, str]:

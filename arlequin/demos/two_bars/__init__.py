@@ -14,6 +14,8 @@ Modules: :mod:`.config` (``TwoBarsConfig``, the ``arlequin two-bars`` options), 
 (``TwoBarsResult``) and :mod:`.report` (the results folder and the picture).
 """
 
+from ..config import register_runner
+from . import run as _run
 from .api import run_two_bars
 from .config import TwoBarsConfig
 from .exact import exact_two_bars, impact_metrics
@@ -31,3 +33,6 @@ __all__ = [
     "run_two_bars",
     "run_wall",
 ]
+
+# the configuration runs through its package's runner (it does not import its run module)
+register_runner(TwoBarsConfig, _run.run_config)

@@ -4,9 +4,7 @@ with the bar on a rigid wall."""
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any, ClassVar
 
 import numpy as np
@@ -105,15 +103,6 @@ class TwoBarsConfig(DemoConfig):
                 f"bar 1 must approach bar 2: velocity={self.velocity} <= velocity2={self.velocity2}"
             )
         check_schemes(self.method, self.newmark, self.integrator)
-
-    def run(
-        self, out: str | Path | None = None, progress: Callable[[float], None] | None = None
-    ) -> Any:
-        """The impact (both runs for ``method="both"``); ``progress(fraction)`` of the simulated
-        time; returns its :class:`~arlequin.demos.two_bars.TwoBarsResult`."""
-        from .run import run_config
-
-        return run_config(self, out, progress)
 
     def progress_scale(self) -> tuple[float, str, float, str]:
         """Percent of the simulated time (both runs of ``method="both"`` together)."""

@@ -10,6 +10,8 @@ Modules: :mod:`.config` (``WaveConfig``, the ``arlequin wave`` options), :mod:`.
 :mod:`.report` (the results folder and ``plot_wave``).
 """
 
+from ..config import register_runner
+from . import run as _run
 from .api import run_wave
 from .config import INTEGRATORS, WaveConfig
 from .report import plot_wave
@@ -17,3 +19,6 @@ from .result import WaveResult
 from .setup import wave_layout
 
 __all__ = ["INTEGRATORS", "WaveConfig", "WaveResult", "plot_wave", "run_wave", "wave_layout"]
+
+# the configuration runs through its package's runner (it does not import its run module)
+register_runner(WaveConfig, _run.run_config)

@@ -3,9 +3,7 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any, ClassVar
 
 from ...solvers import get_integrator
@@ -76,15 +74,6 @@ class WaveConfig(DemoConfig):
     def registry_name(self) -> str:
         """The integrator's name in :func:`arlequin.solvers.get_integrator`."""
         return INTEGRATORS.get(self.integrator, self.integrator)
-
-    def run(
-        self, out: str | Path | None = None, progress: Callable[[float], None] | None = None
-    ) -> Any:
-        """The coupled and the reference runs; ``progress(fraction)`` of the coupled run's
-        steps; returns its :class:`~arlequin.demos.wave.WaveResult`."""
-        from .run import run_config
-
-        return run_config(self, out, progress)
 
     def progress_scale(self) -> tuple[float, str, float, str]:
         """Percent of the coupled run's steps."""
