@@ -149,6 +149,24 @@ def test_results_layer_imports_only_the_dof_layout_and_the_mesh_checks():
     assert not bad, bad
 
 
+def test_every_import_statement_is_an_edge(tmp_path):
+    """Module level, inside a function, under ``if TYPE_CHECKING:``: each import is an edge."""
+    source = tmp_path / "mod.py"
+    source.write_text(
+        "from typing import TYPE_CHECKING\n"
+        "from .a import x\n"
+        "if TYPE_CHECKING:\n"
+        "    from .b import y\n"
+        "def f():\n"
+        "    from . import c\n"
+        "    import arlequin.d\n",
+        encoding="utf-8",
+    )
+    known = {f"arlequin.p.{m}" for m in "abc"} | {"arlequin.d"}
+    found = imports_of(source, "arlequin.p.mod", known)
+    assert found == known, found
+
+
 def test_no_import_cycle():
     g = graph()
     state: dict[str, int] = {}
