@@ -16,6 +16,7 @@ The models are duck-typed: a patch model with ``equivalent_plastic_strain(state)
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -85,11 +86,24 @@ def _measures(model: Any) -> tuple[Any, Any] | None:
     return eqps, basis
 
 
+#: per patch coupling: its band's cell mask and quadrature weights (a dynamic run measures
+#: the band at every recorded sample; the patch's mesh and band do not change)
+_BANDS: weakref.WeakKeyDictionary[Any, tuple[np.ndarray, np.ndarray]] = weakref.WeakKeyDictionary()
+
+
 def band_cells(pc: PatchCoupling) -> np.ndarray:
     """The patch cells of the gluing band, shape (n_fine_elems,) bool."""
     mask = np.zeros(pc.fine_model.mesh.nelements, dtype=bool)
     mask[pc.overlap.fine_cells[pc.gluing_cells]] = True
     return mask
+
+
+def _band(pc: PatchCoupling, basis_of: Any) -> tuple[np.ndarray, np.ndarray]:
+    """The band's cell mask and quadrature weights (n_band, n_qp), computed once per patch."""
+    if pc not in _BANDS:
+        mask = band_cells(pc)
+        _BANDS[pc] = (mask, np.asarray(basis_of().dx)[mask])
+    return _BANDS[pc]
 
 
 def band_plasticity(pc: PatchCoupling, state: Any) -> BandPlasticity | None:
@@ -112,8 +126,7 @@ def band_plasticity(pc: PatchCoupling, state: Any) -> BandPlasticity | None:
         return None
     eqps_of, basis_of = measures
     eqps = np.asarray(eqps_of(state))  # (n_elems, n_qp)
-    band = band_cells(pc)
-    weight = np.asarray(basis_of().dx)[band]
+    band, weight = _band(pc, basis_of)
     in_band = eqps[band]
     plastic = in_band > 0.0
     total = float(weight.sum())
@@ -154,4 +167,5 @@ def plastic_peak(model: Any, state: Any, band: np.ndarray | None = None) -> Plas
 def largest_plastic_strain(pc: PatchCoupling, state: Any) -> PlasticPeak | None:
     """The largest equivalent plastic strain of the patch of ``pc`` and whether it lies in the
     gluing band (None for a patch model without plastic strain)."""
-    return plastic_peak(pc.fine_model, state, band_cells(pc))
+    return plastic_peak(pc.fine_model, state, _band(pc, pc.fine_model.scalar_basis)[0]
+                        if _measures(pc.fine_model) else None)  # fmt: skip

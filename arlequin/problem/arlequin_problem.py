@@ -372,7 +372,8 @@ class ArlequinProblem:
 
         # unloaded: no load function, so that an explicit step does not build and test a
         # vector of zeros at every step
-        return CoupledSystem(blocks, constraints, load_fn if parts else None)
+        return CoupledSystem(blocks, constraints, load_fn if parts else None,
+                             band_plasticity=self.band_plasticity)  # fmt: skip
 
     def field_layout(self) -> FieldLayout:
         """What a results folder shows of this problem: each block's mesh with its cell-mean

@@ -19,6 +19,7 @@ assembled system's dof map. Units are SI.
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -152,10 +153,25 @@ class MultiBodyProblem:
                 f[off : off + s.n_dofs] = s.external_force(t)
             return f
 
-        out = CoupledSystem(blocks, constraints, load if loaded else None)
+        out = CoupledSystem(blocks, constraints, load if loaded else None,
+                            band_plasticity=self.band_plasticity)  # fmt: skip
         for b, s in systems.items():  # the operators computed once, on the body's system
             for blk in s.blocks:
                 out.share_block(_join(b, blk.name), s, blk)
+        return out
+
+    def band_plasticity(self, states: dict[str, list[Any]]) -> list[Any]:
+        """Plastic flow in the gluing bands of every body's J2 patches for the blocks'
+        ``states`` (assembled names), each named by its assembled block name
+        (:meth:`ArlequinProblem.band_plasticity`)."""
+        out = []
+        for name, body in self.bodies.items():
+            measure = getattr(body, "band_plasticity", None)
+            if not callable(measure):
+                continue
+            prefix = _join(name, "")
+            own = {k[len(prefix) :]: v for k, v in states.items() if k.startswith(prefix)}
+            out += [replace(band, patch=_join(name, band.patch)) for band in measure(own)]
         return out
 
     def with_body(self, name: str, body: Any) -> MultiBodyProblem:

@@ -177,11 +177,16 @@ class CoupledSystem:
         ``load(t) -> (n,)`` external force vector (N) at time t (s), already weighted.
     dofmap : DofMap
         The blocks' dof layout (set on construction).
+    band_plasticity : callable or None
+        ``band_plasticity(states) -> list`` of the problem that built the system: plastic flow
+        in its J2 patches' gluing bands (:meth:`ArlequinProblem.band_plasticity`), which the
+        solvers watch; None for a system built by hand.
     """
 
     blocks: list[Block]
     constraints: list[LinearConstraint] = field(default_factory=list)
     load: Callable[[float], np.ndarray] | None = None
+    band_plasticity: Callable[[dict[str, list[Any]]], list[Any]] | None = None
 
     def __post_init__(self) -> None:
         self.dofmap = DofMap(

@@ -24,6 +24,7 @@ from .recorder import Recorder
 from .registry import get_integrator
 from .result import DynamicResult
 from .threads import blas_threads
+from .yield_watch import BandYieldWatch
 
 logger = logging.getLogger(__name__)
 
@@ -199,7 +200,9 @@ def _solve(cls, system, t_end, dt, n_steps, t0, u0, v0, t_eval, step_controller,
         stops.append(t_end)
     if stops:
         integ.set_stops(stops)
-    rec = Recorder(integ, save_fields, tuple(on_record))
+    # the J2 patches' gluing bands at every sample (the problem's own band_plasticity)
+    band = BandYieldWatch(lambda: getattr(adapt, "problem", system), when="t", deferred=True)
+    rec = Recorder(integ, save_fields, (*on_record, band))
     if restore is not None:
         snapshot, recorder_state = restore
         integ.restore(snapshot)
@@ -230,9 +233,19 @@ def _solve(cls, system, t_end, dt, n_steps, t0, u0, v0, t_eval, step_controller,
                 new.set_stops(stops)
             return new
 
-        loop.adapter = DynamicAdapter(adapt, build, (*on_step, *on_record))
-        return run_adaptive_loop(loop, adapt)
-    return loop.run()
+        loop.adapter = DynamicAdapter(adapt, build, (*on_step, *on_record, band))
+    return _watched(loop, adapt, band)
+
+
+def _watched(loop: _Loop, adapt: Any, band: BandYieldWatch) -> DynamicResult:
+    """The loop's run, its result (a failure's too) with the bands' largest plastic share."""
+    try:
+        result = run_adaptive_loop(loop, adapt) if adapt is not None else loop.run()
+    except SimulationError as err:
+        if isinstance(err.result, DynamicResult):
+            band.finish(err.result)
+        raise
+    return band.finish(result)
 
 
 def _check_options(cls, options) -> None:

@@ -87,6 +87,9 @@ class DynamicResult:
     damping_work : dict
         Block name -> work of the damping forces since the start (J, ≤ 0), shape (n_rec,):
         zeros without :class:`~arlequin.solvers.RayleighDamping`.
+    band_plastic_fraction : float or None
+        The largest share of a J2 patch's gluing band that was plastic at a recorded sample
+        (None: no J2 patch; :class:`~arlequin.solvers.yield_watch.BandYieldWatch`).
     stored, dissipation : dict
         Block name -> stored energy and accumulated plastic dissipation (J), shape (n_rec,),
         of the models that offer them (``stored_energy_of_state``, ``plastic_dissipation``);
@@ -119,6 +122,7 @@ class DynamicResult:
     damping_work: dict[str, np.ndarray] = field(default_factory=dict)
     stored: dict[str, np.ndarray] = field(default_factory=dict)
     dissipation: dict[str, np.ndarray] = field(default_factory=dict)
+    band_plastic_fraction: float | None = None
 
     @property
     def success(self) -> bool:

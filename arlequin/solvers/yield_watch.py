@@ -29,21 +29,36 @@ class BandYieldWatch:
         with ``band_plasticity(states)`` (an :class:`~arlequin.ArlequinProblem`) is watched.
     when : str
         What the run's clock is in the warning: ``"λ"`` (a load factor) or ``"t"`` (s).
+    deferred : bool
+        Warn at :meth:`finish` rather than at the first plastic band: a dynamic adaptive run
+        may reject the interval of a sample (:meth:`on_rewind` forgets it).
 
     Attributes
     ----------
     fraction : float or None
-        Largest share of a band's quadrature weight that was plastic at a check (None before
-        any check of a problem with a J2 patch).
-    worst : arlequin.coupling.band_plasticity.BandPlasticity or None
-        The band measure of that check.
+        Largest share of a band's quadrature weight that was plastic at a kept check (None
+        before any check of a problem with a J2 patch).
+    worst : BandPlasticity or None
+        The band measure of that check (None while every band is elastic).
     """
 
-    def __init__(self, problem_of: Callable[[], Any], when: str = "λ") -> None:
-        self.problem_of, self.when = problem_of, when
-        self.fraction: float | None = None
-        self.worst: Any = None
+    def __init__(self, problem_of: Callable[[], Any], when: str = "λ",
+                 deferred: bool = False) -> None:  # fmt: skip
+        self.problem_of, self.when, self.deferred = problem_of, when, bool(deferred)
+        self.watched = False
+        #: (clock, band) of the checks that found a plastic band, in order
+        self.plastic: list[tuple[float, Any]] = []
         self.warned = False
+
+    @property
+    def fraction(self) -> float | None:
+        if not self.watched:
+            return None
+        return max((band.fraction for _, band in self.plastic), default=0.0)
+
+    @property
+    def worst(self) -> Any:
+        return max(self.plastic, key=lambda s: s[1].fraction)[1] if self.plastic else None
 
     def __call__(self, solver: Any) -> None:
         """Measure the bands at the solver's committed ``states`` (at its ``t``)."""
@@ -51,23 +66,35 @@ class BandYieldWatch:
         if not callable(measure):
             return
         for band in measure(solver.states):
-            if self.fraction is None or band.fraction > self.fraction:
-                self.fraction, self.worst = band.fraction, band
-            if band.fraction > 0.0 and not self.warned:
-                self.warned = True
-                x = ", ".join(f"{c:.4g}" for c in band.position)
-                warnings.warn(
-                    f"at {self.when} = {solver.t:.6g} {band.patch} yields in its gluing band "
-                    f"({band.fraction:.3g} of the band plastic, largest plastic strain "
-                    f"{band.peak:.3g} at x = ({x}) m): the band's fields are the coupling's, "
-                    "not the material's (widen the patch so that its plastic zone stays inside "
-                    "the band's inner edge, or use mediator='fine', exact on a nested patch)",
-                    BandYieldWarning,
-                    stacklevel=3,
-                )
+            self.watched = True
+            if band.fraction > 0.0:
+                self.plastic.append((float(solver.t), band))
+        if not self.deferred:
+            self._warn()
+
+    def on_rewind(self, integ: Any) -> None:
+        """A rejected interval: forget the checks after the integrator's time."""
+        self.plastic = [(t, band) for t, band in self.plastic if t <= float(integ.t)]
+
+    def _warn(self) -> None:
+        if self.warned or not self.plastic:
+            return
+        self.warned = True
+        t, band = self.plastic[0]
+        x = ", ".join(f"{c:.4g}" for c in band.position)
+        warnings.warn(
+            f"at {self.when} = {t:.6g} {band.patch} yields in its gluing band "
+            f"({band.fraction:.3g} of the band plastic, largest plastic strain {band.peak:.3g} "
+            f"at x = ({x}) m): the band's fields are the coupling's, not the material's (widen "
+            "the patch so that its plastic zone stays inside the band's inner edge, or use "
+            "mediator='fine', exact on a nested patch)",
+            BandYieldWarning,
+            stacklevel=4,
+        )
 
     def finish(self, result: Any) -> Any:
-        """``result`` with ``band_plastic_fraction`` (the largest share seen, None if nothing
-        was watched)."""
+        """``result`` with ``band_plastic_fraction`` (the largest share kept, None if nothing
+        was watched); a deferred watch warns here."""
+        self._warn()
         result.band_plastic_fraction = self.fraction
         return result

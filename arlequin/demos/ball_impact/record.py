@@ -166,10 +166,13 @@ class ImpactRecorder:
             raise ValueError(f"the ball is still in contact at the end of the run "
                              f"(t_end={t[-1]:.4g} s): give a longer t_end")  # fmt: skip
         max_eqps = band_eqps = 0.0
+        where: list[float] | None = None
         part = b.plastic_part()
         if part is not None:
             eqps = res.states[part[1]][part[2]].eqps
             max_eqps = float(np.max(eqps))
+            cell, point = np.unravel_index(int(np.argmax(eqps)), eqps.shape)
+            where = np.asarray(part[0].quadrature_points())[:, cell, point].tolist()
             if b.band_cells.size:
                 band_eqps = float(np.max(eqps[b.band_cells]))
         v0 = float(config.get("velocity", 0.0))  # the impact velocity, before any contact
@@ -184,6 +187,7 @@ class ImpactRecorder:
             n_steps=int(res.n_steps), fine_size=b.sizes.fine, coarse_size=b.sizes.coarse,
             contact_radius_cells=self.contact_radius / b.sizes.fine,
             band_max_plastic_strain=band_eqps, config=dict(config),
+            band_plastic_fraction=res.band_plastic_fraction, max_plastic_strain_position=where,
             coarse_step_ratio=int(config.get("coarse_step_ratio", 1)),
             mean_step_ratio=float(np.mean(self.macro_ratios)) if self.macro_ratios else 1.0,
         )  # fmt: skip

@@ -56,7 +56,8 @@ RESULT_UNITS = {"contact_duration": "s", "peak_force": "N", "restitution": "1",
                 "hertz_peak_force": "N", "hertz_contact_duration": "s",
                 "hertz_indentation": "m", "hertz_contact_radius": "m", "fine_size": "m",
                 "coarse_size": "m", "n_steps": "1", "contact_radius_cells": "1",
-                "band_max_plastic_strain": "1", "t_end": "s",
+                "band_max_plastic_strain": "1", "t_end": "s", "band_plastic_fraction": "1",
+                "max_plastic_strain_position": "m",
                 "mean_step_ratio": "1", "adaptations": ADAPTATIONS_UNIT,
                 "max_coarse_yield_ratio": "1"}  # fmt: skip
 
@@ -126,6 +127,11 @@ class BallImpactResult(JsonResult):
     band_max_plastic_strain : float
         The largest ε̄p in the block patch's gluing band (1; the coarse model glued there is
         elastic: a warning above 0.02).
+    band_plastic_fraction : float or None
+        The largest share of the block patch's gluing band that was plastic at a recorded
+        sample (1; None without a J2 patch: a ``BandYieldWarning`` above 0).
+    max_plastic_strain_position : list of float or None
+        Where the final largest ε̄p lies (m, reference configuration; None: elastic regime).
     t_end : float
         The simulated time (s): the given one, or the default the run chose.
     coarse_step_ratio : int
@@ -159,6 +165,8 @@ class BallImpactResult(JsonResult):
     coarse_size: float = 0.0
     contact_radius_cells: float = 0.0
     band_max_plastic_strain: float = 0.0
+    band_plastic_fraction: float | None = None
+    max_plastic_strain_position: list[float] | None = None
     t_end: float = 0.0
     coarse_step_ratio: int = 1
     mean_step_ratio: float = 1.0
