@@ -120,8 +120,8 @@ from .io import ResultsFolder
 from .problem.arlequin_problem import ArlequinProblem
 from .problem.bodies import MultiBodyProblem
 from .solvers import DynamicResult, solve
-from .solvers.quasi_static import NewtonError, QuasiStaticResult, solve_quasi_static
-from .solvers.static import SingularSystemError, StaticResult, solve_static
+from .solvers.statics.quasi_static import NewtonError, QuasiStaticResult, solve_quasi_static
+from .solvers.statics.static import SingularSystemError, StaticResult, solve_static
 
 __version__ = "0.1.0"
 

@@ -2,9 +2,10 @@
 
 The patch that grows (:class:`AdaptivePatch`, its records and errors) lives in
 :mod:`arlequin.problem.adapt`, with the problem it rebuilds; the load stepping that drives it in
-:mod:`arlequin.solvers.adaptive` (``solve_quasi_static(problem, ..., adapt=AdaptivePatch())``)
-and, in explicit runs, in :mod:`arlequin.solvers.adaptive_dynamic` (``solve(problem, "explicit",
-..., adapt=AdaptivePatch())``); :class:`BodyAdaptation` adapts the patch of one body of a
+:mod:`arlequin.solvers.statics.adaptive` (``solve_quasi_static(problem, ...,
+adapt=AdaptivePatch())``) and, in explicit runs, in
+:mod:`arlequin.solvers.dynamics.adaptive_dynamic` (``solve(problem, "explicit", ...,
+adapt=AdaptivePatch())``); :class:`BodyAdaptation` adapts the patch of one body of a
 multi-body problem (the ball impact's block).
 """
 
@@ -18,7 +19,7 @@ from .problem.adapt import (
     PatchLimitError,
 )
 from .problem.adapt_bodies import BodyAdaptation
-from .solvers.adaptive import run_adaptive
+from .solvers.statics.adaptive import run_adaptive
 
 __all__ = [
     "AdaptView",

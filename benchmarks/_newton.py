@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 import scipy.sparse.linalg as spla
 
-from arlequin.solvers import quasi_static
+from arlequin.solvers.statics import quasi_static
 
 #: Item 5's window and factor: r_k below START, r_k+1 above STOP, r_k+1 ≤ FACTOR r_k².
 START, STOP, FACTOR = 1e-3, 1e-10, 10.0

@@ -3,7 +3,7 @@
 Imported before numba runs its first kernel: OpenMP threads sleep between parallel regions
 (``OMP_WAIT_POLICY=PASSIVE``, unless set), so that a spinning worker does not slow the serial
 part of each step on a small machine; the explicit loop runs BLAS on one thread
-(:mod:`arlequin.solvers.threads`). :func:`settings` goes into each benchmark's JSON.
+(:mod:`arlequin.linalg.threads`). :func:`settings` goes into each benchmark's JSON.
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """The explicit step's time split into compiled kernels, linear algebra and the rest (overhead).
 
 Runs a short window of a demo with the library's step timers on
-(:class:`arlequin.solvers.timing.StepTimer`: ``time.perf_counter`` around the models' internal
+(:class:`arlequin.linalg.timing.StepTimer`: ``time.perf_counter`` around the models' internal
 forces, around the sparse/dense products and solves, and around each whole step; no profiler)
 and prints JSON: steps, steps per second, the seconds of the steps in kernels, in linear algebra
 and in the rest, the overhead's share of the step, the elements, the wall time of the run and the
@@ -91,7 +91,7 @@ def _share(rep: dict, *also: str) -> float:
 
 def measure(case: str, t_end: float | None = None, repeat: int = 1, clock: str = "wall") -> dict:
     """The timed split of ``case`` (see the module docstring) as a JSON-ready dict."""
-    from arlequin.solvers.timing import StepTimer
+    from arlequin.linalg.timing import StepTimer
 
     if case not in CASES:
         raise ValueError(f"case must be one of {CASES}, got {case!r}")

@@ -18,7 +18,7 @@ with a linear hardening modulus H of 0, E/1000, E/100 and E/10 (perfect plastici
 what makes C large). ``--no-newton`` skips them.
 
 The coarse elastic plate has fewer free dofs than a quarter of the patch's, so the quasi-static
-solver does not condense it (:data:`arlequin.solvers.condensation.MIN_LINEAR_SHARE`): the
+solver does not condense it (:data:`arlequin.solvers.statics.condensation.MIN_LINEAR_SHARE`): the
 Arlequin run is also timed with the condensation forced (that share set to 0),
 ``arlequin_condensed``, to show what condensing would give.
 
@@ -39,8 +39,9 @@ import numpy as np
 from _newton import contraction_summary, newton_record
 
 from arlequin.demos.plate_with_hole import run_plate_with_hole
+from arlequin.linalg import direct
 from arlequin.models import SmallStrainJ2
-from arlequin.solvers import condensation, direct
+from arlequin.solvers.statics import condensation
 
 MODELS = ("mono", "arlequin", "graded")
 
@@ -73,7 +74,7 @@ def timed_run(model: str, levels: int, steps: int, repeat: int):
 @contextmanager
 def timed_split():
     """Wall time spent in the J2 return and force, its tangent's assembly, the Newton systems'
-    factorisations and solves (:class:`arlequin.solvers.direct.SparseDirectSolver`, whichever
+    factorisations and solves (:class:`arlequin.linalg.direct.SparseDirectSolver`, whichever
     backend), by wrapping those functions (restored after)."""
     split = {"constitutive_update": 0.0, "tangent_assembly": 0.0, "factorisation": 0.0,
              "solves": 0.0}  # fmt: skip

@@ -20,7 +20,7 @@ first-yield probe and the run):
 * ``constitutive_and_tangent_s``: the models' internal forces, return maps and tangent
   assembly;
 * ``factorisation_s`` and ``solve_s``: the Newton systems' factorisations and solves
-  (:mod:`arlequin.solvers.direct`: SuperLU, or PARDISO keeping its symbolic analysis);
+  (:mod:`arlequin.linalg.direct`: SuperLU, or PARDISO keeping its symbolic analysis);
 * ``other_s``: the rest of the load steps (residuals, line search, the condensation's
   products);
 * ``setup_s``: the wall time outside the load steps (meshes, couplings, the operators'
@@ -90,7 +90,7 @@ class _PeakRSS:
 def sphere(model: str, dim: int = 2, condense: bool = True, linear_solver: str = "superlu",
            **config) -> dict:  # fmt: skip
     """One sphere run, timed; its accuracy against Hill at the final pressure."""
-    import arlequin.solvers.quasi_static as qs_module
+    import arlequin.solvers.statics.quasi_static as qs_module
     from arlequin.demos.pressure_vessel import PressureVesselConfig
     from arlequin.demos.pressure_vessel.run import run
 
@@ -211,7 +211,7 @@ def _cases(args) -> list[tuple]:
 
 
 def main() -> None:
-    from arlequin.solvers.direct import pardiso_available
+    from arlequin.linalg.direct import pardiso_available
 
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--case", choices=("sphere-2d", "sphere-3d", "all"), default="sphere-2d")

@@ -58,7 +58,7 @@ from arlequin.demos.plate_with_hole.meshes import (
 )
 from arlequin.models import IsotropicElastic, LinearElastic
 from arlequin.problem.arlequin_problem import ArlequinProblem, Patch
-from arlequin.solvers.static import solve_static
+from arlequin.solvers.statics.static import solve_static
 
 __all__ = ["hole_nodes", "project_hole_nodes", "quarter_plate_mesh", "refine_projected", "run"]
 

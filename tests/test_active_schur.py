@@ -1,4 +1,4 @@
-"""The compiled factor of the active rows' impulse matrix (arlequin/solvers/active_schur.py)
+"""The compiled factor of the active rows' impulse matrix (arlequin/linalg/active_schur.py)
 against its dense numpy/LAPACK reference (the lines of ImpulseSolver it replaced)."""
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 
 from arlequin.contract import ConstraintError
-from arlequin.solvers.active_schur import ActiveSchur
+from arlequin.linalg.active_schur import ActiveSchur
 
 
 def _rows(seed: int, m: int = 7, n: int = 40, per_row: int = 5) -> sp.csr_matrix:

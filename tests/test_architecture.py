@@ -5,12 +5,12 @@ Rules (the table of docs/architecture.md):
 * ``arlequin/`` outside ``demos/`` and ``cli/`` never imports the models;
 * ``models/`` imports from ``arlequin`` only the contract and the pure helpers
   (:data:`MODEL_ALLOWED`);
-* the integrators never import the results layer (``arlequin.io``) nor the problem set-up;
+* the integrators never import the results layer (``arlequin.io``) nor the problem set-up, and
+  the linear algebra below them (``arlequin.linalg``) imports only the contract;
 * no import cycle among the package's modules (each module is a node; ``from . import x`` and
   ``from .x import y`` are edges to the module x; every import statement is an edge, inside a
   function or under ``if TYPE_CHECKING:`` too);
-* no package folder holds more than 15 modules (:data:`MAX_MODULES`), ``arlequin/solvers``
-  excepted until issue 42 splits it;
+* no package folder holds more than 15 modules (:data:`MAX_MODULES`);
 * no function more complex than 20 by radon's count outside the compiled kernels;
 * no module above 500 lines unless its docstring says why (a line starting ``Size:``).
 """
@@ -107,6 +107,9 @@ def test_models_import_only_the_contract_and_pure_helpers():
     assert not bad, bad
 
 
+#: What every part of the solvers may import from below them.
+SOLVERS_BELOW = ("arlequin.contract", "arlequin.dofs", "arlequin.problem.system", "arlequin.linalg")
+
 #: Each layer of the core and what it may import from the package besides itself (the table of
 #: docs/architecture.md).
 LAYERS = {
@@ -121,7 +124,18 @@ LAYERS = {
         "arlequin.coupling",
         "arlequin.io.layout",
     ),
-    "arlequin.solvers": ("arlequin.contract", "arlequin.dofs", "arlequin.problem.system"),
+    "arlequin.linalg": ("arlequin.contract",),
+    "arlequin.solvers": SOLVERS_BELOW,
+    # inside the solvers: the system's operators and rows, then the time integrators and the
+    # static solvers side by side (neither imports the other), then the dynamic run
+    "arlequin.solvers.system": SOLVERS_BELOW,
+    "arlequin.solvers.dynamics": (*SOLVERS_BELOW, "arlequin.solvers.system"),
+    "arlequin.solvers.statics": (*SOLVERS_BELOW, "arlequin.solvers.system"),
+    "arlequin.solvers.run": (
+        *SOLVERS_BELOW,
+        "arlequin.solvers.system",
+        "arlequin.solvers.dynamics",
+    ),
 }
 
 
@@ -260,10 +274,6 @@ def test_functions_stay_under_complexity_20():
 #: The most modules (``__init__.py`` aside) one package folder may hold.
 MAX_MODULES = 15
 
-#: Folders exempt from :data:`MAX_MODULES` for now. ``arlequin/solvers`` (32 modules) is to be
-#: split into sub-packages by issue 42; that split is pending: drop the exception with it.
-OVERSIZED_FOLDERS = {"arlequin.solvers"}
-
 
 def test_package_folders_hold_at_most_15_modules():
     counts: dict[str, int] = {}
@@ -271,11 +281,8 @@ def test_package_folders_hold_at_most_15_modules():
         if path.name != "__init__.py":
             package = module_name(path.parent / "__init__.py")
             counts[package] = counts.get(package, 0) + 1
-    big = {p: n for p, n in counts.items() if n > MAX_MODULES and p not in OVERSIZED_FOLDERS}
+    big = {p: n for p, n in counts.items() if n > MAX_MODULES}
     assert not big, big
-    # an exception no longer needed is dropped (the split done)
-    done = [p for p in OVERSIZED_FOLDERS if counts.get(p, 0) <= MAX_MODULES]
-    assert not done, f"{done} hold at most {MAX_MODULES} modules: drop their exception"
 
 
 def test_demos_are_packages():

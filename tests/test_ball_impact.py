@@ -248,7 +248,7 @@ def test_a_zoned_body_has_one_law_per_cell():
     # mesh's dofs, plus the elastic one of the other cells on the zone's nodes
     from arlequin.demos.ball_impact import COPPER
     from arlequin.demos.ball_impact.zoned import ZonedBody
-    from arlequin.solvers.operators import SystemOperators
+    from arlequin.solvers.system.operators import SystemOperators
 
     mesh = skfem.MeshQuad.init_tensor(np.linspace(0, 0.01, 9), np.linspace(-0.01, 0, 9))
     centres = mesh.p[:, mesh.t].mean(axis=1)

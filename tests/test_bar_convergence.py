@@ -17,7 +17,7 @@ import skfem
 from arlequin.coupling.patches import refine_region
 from arlequin.models import IsotropicElastic, LinearElastic
 from arlequin.problem.arlequin_problem import ArlequinProblem, Patch
-from arlequin.solvers.static import solve_static
+from arlequin.solvers.statics.static import solve_static
 
 E, F0 = 1.0e9, 1.0e6
 

@@ -217,7 +217,7 @@ def test_rows_on_a_kept_pattern_equal_scipy_constructions():
     # csr_with_data against scipy's constructor (exact: the same arrays), the template's index
     # arrays read-only and shared, and stack_active's pattern path against a fresh stacking
     from arlequin.contract import csr_pattern, csr_with_data, same_pattern
-    from arlequin.solvers.rows import stack_active
+    from arlequin.solvers.system.rows import stack_active
 
     rng = np.random.default_rng(3)
     m, w, n = 5, 4, 40

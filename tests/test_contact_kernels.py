@@ -1,5 +1,5 @@
 """The contact step's shortcuts against their references (models/contact/kernel.py, records.py,
-the plane's fixed rows, arlequin/solvers/rows.py's kept patterns): every comparison is exact,
+the plane's fixed rows, arlequin/solvers/system/rows.py's kept patterns): every comparison is exact,
 byte for byte, since the shortcuts claim the same numbers as the numpy and scipy paths."""
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ from arlequin.models.contact.kernel import (
     scaled_entries,
 )
 from arlequin.models.contact.records import ContactTrial, build, evolve
-from arlequin.solvers.rows import stack_active
+from arlequin.solvers.system.rows import stack_active
 
 
 def same_bytes(a, b) -> bool:

@@ -1,4 +1,4 @@
-"""The compiled CSR product (arlequin/solvers/csr.py) against scipy's ``A @ x``.
+"""The compiled CSR product (arlequin/linalg/csr.py) against scipy's ``A @ x``.
 
 The explicit loop's linear forces go through it (and its power sums through block_sums.py),
 and the issue-30 rule is that the histories do not change: so the products must be scipy's
@@ -14,8 +14,8 @@ import scipy.sparse as sp
 import skfem
 from skfem.models.elasticity import lame_parameters, linear_elasticity
 
-from arlequin.solvers import csr
-from arlequin.solvers.csr import CsrProduct
+from arlequin.linalg import csr
+from arlequin.linalg.csr import CsrProduct
 
 
 def random_csr(seed: int) -> sp.csr_matrix:
@@ -82,7 +82,7 @@ def test_product_keeps_its_own_copy_and_checks_the_vector():
 def test_signed_block_sums_are_the_bincount_sums():
     # the explicit loop's per-block powers −Σ_{j∈b} f_j x_j over the touched dofs, compiled:
     # the same additions in the same order as a weighted bincount, so the same floats
-    from arlequin.solvers.block_sums import signed_block_sums, touched_index
+    from arlequin.linalg.block_sums import signed_block_sums, touched_index
 
     rng = np.random.default_rng(11)
     n, n_blocks = 500, 4
@@ -112,8 +112,8 @@ def test_signed_block_sums_are_the_bincount_sums():
 def test_kind_block_powers_are_the_per_kind_products_and_sums(kinds):
     # the equality rows' powers of both kinds for two vectors in one compiled pass: the bits of
     # the code it replaced (each kind's Bᵀλ by CsrProduct, then signed_block_sums per vector)
-    from arlequin.solvers.block_sums import kind_block_powers, signed_block_sums, touched_index
-    from arlequin.solvers.csr import CsrProduct
+    from arlequin.linalg.block_sums import kind_block_powers, signed_block_sums, touched_index
+    from arlequin.linalg.csr import CsrProduct
 
     rng = np.random.default_rng(12)
     m, n, n_blocks = 60, 400, 3
@@ -147,7 +147,7 @@ def test_kind_block_powers_are_the_per_kind_products_and_sums(kinds):
 def test_scattered_block_powers_are_the_bincount_force_and_sums():
     # a few active rows' powers for two vectors in one compiled pass: the bits of
     # np.bincount for the force Gᵀλ on the touched dofs, then signed_block_sums per vector
-    from arlequin.solvers.block_sums import scattered_block_powers, signed_block_sums, touched_index
+    from arlequin.linalg.block_sums import scattered_block_powers, signed_block_sums, touched_index
 
     rng = np.random.default_rng(13)
     m, n, n_blocks = 9, 300, 4
@@ -169,7 +169,7 @@ def test_scattered_block_powers_are_the_bincount_force_and_sums():
 def test_csr_times_subtract_scaled_is_the_product_then_the_update():
     # the equality rows' impulse v[cols] −= M⁻¹ Bᵀλ in one compiled pass: the bits of the
     # product's vector (CsrProduct, scipy's floats) and then the indexed update
-    from arlequin.solvers.csr import csr_times_subtract_scaled
+    from arlequin.linalg.csr import csr_times_subtract_scaled
 
     rng = np.random.default_rng(14)
     n, m = 300, 40

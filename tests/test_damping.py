@@ -17,7 +17,7 @@ import skfem
 
 from arlequin.models import IsotropicElastic, LinearElastic
 from arlequin.solvers import RayleighDamping, solve
-from arlequin.solvers.operators import as_system
+from arlequin.solvers.system.operators import as_system
 
 MAT = IsotropicElastic(1.0, 0.0, 1.0)
 

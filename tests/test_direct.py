@@ -1,4 +1,4 @@
-"""The sparse direct solvers of the Newton systems (arlequin.solvers.direct): SuperLU always,
+"""The sparse direct solvers of the Newton systems (arlequin.linalg.direct): SuperLU always,
 PARDISO where the optional pypardiso is installed, checked on the saddle point of a small
 Arlequin problem (a coarse plate and a glued patch: symmetric indefinite, with multipliers)
 against a dense solve (exact up to round-off), and their errors."""
@@ -11,9 +11,10 @@ import scipy.sparse as sp
 import skfem
 
 from arlequin import ArlequinProblem, Patch, refine_region, solve_quasi_static
+from arlequin.linalg import direct
+from arlequin.linalg.direct import SparseDirectSolver, resolve_linear_solver
 from arlequin.models import IsotropicElastic, LinearElastic
-from arlequin.solvers import QuasiStaticSolver, direct
-from arlequin.solvers.direct import SparseDirectSolver, resolve_linear_solver
+from arlequin.solvers import QuasiStaticSolver
 
 STEEL = IsotropicElastic(young=210e9, poisson=0.3, density=7850.0)
 

@@ -1,4 +1,4 @@
-"""The integrators' sparse factorisation (arlequin/solvers/linalg.py) against dense solves."""
+"""The integrators' sparse factorisation (arlequin/linalg/factor.py) against dense solves."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import pytest
 import scipy.sparse as sp
 
 from arlequin.contract import ConstraintError
-from arlequin.solvers.linalg import ScaledLU
+from arlequin.linalg.factor import ScaledLU
 
 
 def _spd_with_isolated_rows(n: int, isolated: np.ndarray, seed: int = 0) -> sp.csr_matrix:
@@ -72,7 +72,7 @@ def _fine_mediator_rows(n_coarse: int, ratio: int, seed: int = 0):
 
 
 def test_factor_rows_splits_isolated_rows_and_shared_dofs():
-    from arlequin.solvers.linalg import IsolatedRowsSolver, LowRankSplitSolver, factor_rows
+    from arlequin.linalg.factor import IsolatedRowsSolver, LowRankSplitSolver, factor_rows
 
     b, inv_mass = _fine_mediator_rows(n_coarse=6, ratio=64)
     s = (b @ sp.diags(inv_mass) @ b.T).toarray()
@@ -94,7 +94,7 @@ def test_factor_rows_splits_isolated_rows_and_shared_dofs():
 
 
 def test_factor_rows_without_shared_dofs_is_one_lu():
-    from arlequin.solvers.linalg import factor_rows
+    from arlequin.linalg.factor import factor_rows
 
     b, inv_mass = _fine_mediator_rows(n_coarse=6, ratio=2)  # coarse dofs in 2-3 rows: light
     solver = factor_rows(b[:-3], inv_mass, "test rows")
@@ -105,7 +105,7 @@ def test_factor_rows_without_shared_dofs_is_one_lu():
 
 
 def test_factor_rows_names_dependent_rows():
-    from arlequin.solvers.linalg import factor_rows
+    from arlequin.linalg.factor import factor_rows
 
     b, inv_mass = _fine_mediator_rows(n_coarse=4, ratio=64)
     b = sp.vstack([b, b[10]]).tocsr()  # row 10 twice: the split's A is singular, then S
@@ -131,7 +131,7 @@ def _pivot_basis_rows(n_groups: int, n_rows: int, n_shared: int, seed: int = 0):
 
 @pytest.mark.parametrize("n_groups,n_shared", [(1, 12), (3, 12), (4, 40)])
 def test_factor_rows_diagonal_plus_low_rank(n_groups, n_shared):
-    from arlequin.solvers.linalg import DiagonalLowRankSolver, factor_rows
+    from arlequin.linalg.factor import DiagonalLowRankSolver, factor_rows
 
     b, inv_mass = _pivot_basis_rows(n_groups, n_rows=60, n_shared=n_shared)
     solver = factor_rows(b, inv_mass, "test rows")
@@ -148,7 +148,7 @@ def test_factor_rows_diagonal_plus_low_rank(n_groups, n_shared):
 
 
 def test_factor_rows_diagonal_path_needs_a_private_dof_in_every_row():
-    from arlequin.solvers.linalg import DiagonalLowRankSolver, factor_rows
+    from arlequin.linalg.factor import DiagonalLowRankSolver, factor_rows
 
     b, inv_mass = _pivot_basis_rows(1, n_rows=40, n_shared=10)
     # two rows share their own dofs: no longer private, the other paths take the rows
@@ -164,10 +164,10 @@ def test_factor_rows_diagonal_path_needs_a_private_dof_in_every_row():
 
 
 def test_diagonal_low_rank_groups_beyond_the_dense_size_are_sparse():
-    from arlequin.solvers import linalg
+    from arlequin.linalg import factor
 
     b, inv_mass = _pivot_basis_rows(2, n_rows=800, n_shared=350)
-    solver = linalg.factor_rows(b, inv_mass, "test rows")
+    solver = factor.factor_rows(b, inv_mass, "test rows")
     assert [dense for *_, dense in solver._groups] == [False, False]  # 350 > 300 shared dofs
     s = (b @ sp.diags(inv_mass) @ b.T).toarray()
     rhs = np.random.default_rng(6).standard_normal(b.shape[0])
@@ -181,7 +181,7 @@ def test_impulse_solver_schur_paths_against_the_dense_system(touch):
     # general Schur path) or neither: the impulses of the whole system solved dense
     from types import SimpleNamespace
 
-    from arlequin.solvers.impulses import ImpulseSolver
+    from arlequin.linalg.impulses import ImpulseSolver
 
     b, inv_mass = _pivot_basis_rows(1, n_rows=50, n_shared=10)
     n_b = b.shape[1]

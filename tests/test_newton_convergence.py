@@ -172,7 +172,7 @@ def test_a_resumed_run_writes_the_same_files(tmp_path, monkeypatch):
     """A pressure vessel interrupted after its 6th converged step and resumed: history.csv and
     newton.csv byte for byte those of the uninterrupted run (the pattern of
     tests/test_pressure_vessel.py's resume test)."""
-    import arlequin.solvers.quasi_static as qs
+    import arlequin.solvers.statics.quasi_static as qs
     from arlequin.demos.pressure_vessel import PressureVesselConfig
     from arlequin.demos.pressure_vessel import run as run_module
 

@@ -176,7 +176,7 @@ def test_an_interrupted_run_resumes_bit_for_bit(tmp_path, monkeypatch):
     """A run interrupted after its 6th converged step continues with ``--resume --out DIR``
     from its checkpoint: the same history (pressures, displacements, fronts, Newton's
     iterations and residuals) as the uninterrupted run, bit for bit, and every frame kept."""
-    import arlequin.solvers.quasi_static as qs
+    import arlequin.solvers.statics.quasi_static as qs
     from arlequin.cli.main import main
     from arlequin.demos.pressure_vessel import run as run_module
     from arlequin.io import read_series

@@ -1,4 +1,4 @@
-"""The quasi-static solver (arlequin.solvers.quasi_static): load stepping with Newton on the
+"""The quasi-static solver (arlequin.solvers.statics.quasi_static): load stepping with Newton on the
 coupled saddle point, checked against the linear static solver (exact: the same equations), on
 a nonlinear model with an exact tangent (quadratic convergence), and for its input errors."""
 

@@ -1,4 +1,4 @@
-"""The explicit scheme's impulse basis (arlequin/solvers/row_basis.py).
+"""The explicit scheme's impulse basis (arlequin/solvers/dynamics/row_basis.py).
 
 Exact references: rows B and T⁻¹B are the same constraint, so the M-orthogonal projection of any
 velocity onto them is the same (to round-off), and the multipliers of B are Tᵀ times those of
@@ -23,8 +23,8 @@ from arlequin.demos.ball_impact.setup import ImpactBodies, ball_sizes
 from arlequin.demos.patch_test import build_patch_test_problem
 from arlequin.problem.system import CoupledSystem, LinearConstraint
 from arlequin.solvers import solve
-from arlequin.solvers.operators import SystemOperators
-from arlequin.solvers.row_basis import ImpulseBasis, Multipliers
+from arlequin.solvers.dynamics.row_basis import ImpulseBasis, Multipliers
+from arlequin.solvers.system.operators import SystemOperators
 
 R = 0.01
 

@@ -11,20 +11,20 @@ import pytest
 import scipy.sparse as sp
 
 from arlequin.contract import ConstraintError
-from arlequin.solvers.impulses import ImpulseSolver
-from arlequin.solvers.rows import (
-    rows_times,
-    subtract_transposed,
-    transposed,
-    transposed_times,
-)
-from arlequin.solvers.timing import SWITCH, StepTimer
-from arlequin.solvers.vector_updates import (
+from arlequin.linalg.impulses import ImpulseSolver
+from arlequin.linalg.timing import SWITCH, StepTimer
+from arlequin.linalg.vector_updates import (
     interpolated,
     scaled_plus,
     subtract_scaled_at,
     sum_of_squares,
     work_products,
+)
+from arlequin.solvers.system.rows import (
+    rows_times,
+    subtract_transposed,
+    transposed,
+    transposed_times,
 )
 
 
@@ -174,7 +174,7 @@ def test_dense_active_rows_beside_unshared_equality_rows():
 def test_block_sums_are_the_segmented_sums_of_block_dots():
     # reference: SystemOperators.block_dots, whose per-block sums of x ⊙ y block_sums makes on
     # the products formed beforehand (the explicit step's internal work)
-    from arlequin.solvers.operators import SystemOperators
+    from arlequin.solvers.system.operators import SystemOperators
 
     ops = SystemOperators.__new__(SystemOperators)
     ops.n, ops.blocks, ops.offsets = 7, ["a", "b"], np.array([0, 3, 7])
@@ -226,7 +226,7 @@ def test_block_dots_with_its_buffer_equal_the_plain_products():
     from arlequin.demos.two_bars import TwoBarsConfig
     from arlequin.demos.two_bars.setup import TwoBarsSetup
     from arlequin.problem.system import Block, BlockTerm, CoupledSystem
-    from arlequin.solvers.operators import SystemOperators
+    from arlequin.solvers.system.operators import SystemOperators
 
     bodies = TwoBarsSetup(TwoBarsConfig()).impact("levelset").bodies
     system = CoupledSystem([Block(f"bar{i}", b, [BlockTerm(b)]) for i, b in enumerate(bodies)])

@@ -1,4 +1,4 @@
-"""The multi-time-step scheme (arlequin.solvers.subcycling) on a 1D Arlequin bar.
+"""The multi-time-step scheme (arlequin.solvers.dynamics.subcycling) on a 1D Arlequin bar.
 
 The set-up: a coarse bar of 80 elements (1 m each) with a patch four times finer over its right
 half, glued over 10 m (H1, coarse mediator, ramp weights), a cos² pulse of 10 m in the coarse-only

@@ -280,12 +280,13 @@ def test_verbose_runs_log_their_progress(monkeypatch, caplog):
 
     from arlequin.models import IsotropicElastic, LinearElastic
     from arlequin.problem.system import Block, BlockTerm, CoupledSystem
-    from arlequin.solvers import driver, solve
+    from arlequin.solvers import solve
+    from arlequin.solvers.run import driver
 
     monkeypatch.setattr(driver, "LOG_INTERVAL", 0.0)
     bar = LinearElastic(skfem.MeshLine(np.linspace(0, 1, 11)), IsotropicElastic(1e9, 0.0, 1e3))
     system = CoupledSystem([Block("bar", bar, [BlockTerm(bar)])])
-    with caplog.at_level(logging.INFO, logger="arlequin.solvers.driver"):
+    with caplog.at_level(logging.INFO, logger="arlequin.solvers.run.driver"):
         solve(system, "explicit", n_steps=3, v0=np.ones(bar.n_dofs))
-    lines = [r.getMessage() for r in caplog.records if r.name == "arlequin.solvers.driver"]
+    lines = [r.getMessage() for r in caplog.records if r.name == "arlequin.solvers.run.driver"]
     assert len(lines) == 3 and lines[-1].startswith("step 3, t = ")

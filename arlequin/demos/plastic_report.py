@@ -4,7 +4,8 @@ A J2 patch's largest plastic strain is the quantity a plasticity study reports f
 something only outside the gluing band, where the patch's fields are the material's. The demos
 record it with its place and whether it lies in the band (``max_plastic_strain``,
 ``max_plastic_strain_position``, ``max_plastic_strain_in_band``), and the band's plastic share
-over the run (``band_plastic_fraction``, :class:`~arlequin.solvers.yield_watch.BandYieldWatch`).
+over the run (``band_plastic_fraction``,
+:class:`~arlequin.solvers.system.yield_watch.BandYieldWatch`).
 """
 
 from __future__ import annotations

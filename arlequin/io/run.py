@@ -187,7 +187,8 @@ class QuasiStaticRunWriter:
     far), ``load_factor``, the demo's ``measures``, ``load_step`` (its Δλ), the Newton
     iterations, step cuts, first and last relative residuals, and ``crossings``: the
     quadrature points that crossed the yield surface in each Newton iteration, one count an
-    iteration separated by spaces (:class:`~arlequin.solvers.quasi_static_result.NewtonIteration`).
+    iteration separated by spaces
+    (:class:`~arlequin.solvers.statics.quasi_static_result.NewtonIteration`).
     Each of its Newton iterations appends a row to ``newton.csv``: ``step``, ``load_factor``,
     ``iteration`` (from 1), ``start_residual`` and ``residual`` (the relative residual before
     and after it, as the solver compares it with its tolerance), its ``equilibrium_residual``

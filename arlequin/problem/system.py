@@ -54,7 +54,7 @@ class LinearConstraint:
         aside). The scheme may then write the rows in the basis where they are the identity
         on those dofs, T⁻¹B (the same constraint, the same corrected velocities), whose impulse
         matrix is diagonal plus low rank
-        (:mod:`arlequin.solvers.row_basis`); the fine mediator of a nested patch gives its
+        (:mod:`arlequin.solvers.dynamics.row_basis`); the fine mediator of a nested patch gives its
         band's fine dofs. Rows whose T⁻¹B is not sparse keep their own basis.
     """
 

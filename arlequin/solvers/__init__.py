@@ -18,32 +18,40 @@ Step sizes come from a step controller (:class:`FixedStep`, :class:`CriticalFrac
 are :class:`arlequin.problem.system.LinearConstraint`; unilateral rows (contact) follow
 :class:`arlequin.contract.UnilateralConstraint` (:class:`LinearInequality` is the minimal one).
 
-One concept a module: ``operators`` (mass, forces, tangents), ``rows`` (constraint rows),
-``linalg`` (factorisations), ``impulses`` (the explicit impulse solve), ``damping`` (Rayleigh
-damping), ``controllers`` (step sizes), ``base`` (the :class:`Integrator` class), ``registry``,
-``explicit``, ``subcycling``, ``implicit``, ``stability``, ``recorder``, ``result``, ``driver``
-(:func:`solve`), ``static``, ``quasi_static`` (load stepping with Newton,
-:func:`solve_quasi_static`), ``condensation`` (its Newton systems), ``direct`` (their sparse
-direct solvers: SuperLU, or PARDISO where pypardiso is installed), ``loads``.
+Four sub-packages, one concept a module in each: ``system`` (what every solver reads off the
+coupled system: ``operators`` for masses, forces and tangents, ``rows`` for constraint rows,
+``constraints``, ``loads``, ``yield_watch``), ``dynamics`` (``base``: the :class:`Integrator`
+class, ``registry``, ``controllers`` for step sizes, ``stability``, ``damping`` for Rayleigh
+damping, ``explicit`` with its impulse basis ``row_basis``, ``subcycling``, ``implicit``,
+``adaptive_dynamic``), ``statics`` (``static``, ``quasi_static``: load stepping with Newton,
+:func:`solve_quasi_static`, its result ``quasi_static_result``, ``condensation`` for its Newton
+systems, ``adaptive``) and ``run`` (``driver``: :func:`solve`, ``recorder``, ``result``). The
+linear algebra they call (factorisations, the sparse direct solvers, the explicit impulse solve,
+the compiled products and vector updates) is the layer below, :mod:`arlequin.linalg`.
 """
 
 from ..contract import ConstraintError, SimulationError, UnilateralConstraint
-from .base import Integrator, IntegratorSnapshot
-from .constraints import LinearInequality, is_unilateral
-from .controllers import CriticalFraction, FixedStep, StepController, StepSchedule
-from .damping import RayleighDamping
-from .driver import solve
-from .explicit import CentralDifference
-from .implicit import HHTAlpha, ImplicitIntegrator, Newmark, ThetaScheme
-from .loads import Constant, LoadCurve, Ramp, Sine, SmoothStep, Tabulated
-from .operators import SystemOperators
-from .quasi_static import NewtonError, QuasiStaticResult, QuasiStaticSolver, solve_quasi_static
-from .recorder import Recorder
-from .registry import REGISTRY, get_integrator, register
-from .result import DynamicResult
-from .stability import DEFAULT_SAFETY, StableStep, check_time_step, stable_time_step
-from .static import SingularSystemError, StaticResult, solve_static
-from .subcycling import SubcycledCentralDifference
+from .dynamics.base import Integrator, IntegratorSnapshot
+from .dynamics.controllers import CriticalFraction, FixedStep, StepController, StepSchedule
+from .dynamics.damping import RayleighDamping
+from .dynamics.explicit import CentralDifference
+from .dynamics.implicit import HHTAlpha, ImplicitIntegrator, Newmark, ThetaScheme
+from .dynamics.registry import REGISTRY, get_integrator, register
+from .dynamics.stability import DEFAULT_SAFETY, StableStep, check_time_step, stable_time_step
+from .dynamics.subcycling import SubcycledCentralDifference
+from .run.driver import solve
+from .run.recorder import Recorder
+from .run.result import DynamicResult
+from .statics.quasi_static import (
+    NewtonError,
+    QuasiStaticResult,
+    QuasiStaticSolver,
+    solve_quasi_static,
+)
+from .statics.static import SingularSystemError, StaticResult, solve_static
+from .system.constraints import LinearInequality, is_unilateral
+from .system.loads import Constant, LoadCurve, Ramp, Sine, SmoothStep, Tabulated
+from .system.operators import SystemOperators
 
 __all__ = [
     "DEFAULT_SAFETY",

@@ -366,9 +366,10 @@ class ImpactBodies:
                        energies: dict | None = None) -> tuple[float, float]:  # fmt: skip
         """(elastic energy, plastic dissipation) (J) of the block carrying the J2 law.
 
-        ``energies``: the integrator's :meth:`~arlequin.solvers.base.Integrator.energies` at
-        the same state, if the caller has them. When the J2 law is its block's only term (no
-        zoned body: not ``mono-zoned`` or ``graded``) and has no bulk viscosity, the block's
+        ``energies``: the integrator's
+        :meth:`~arlequin.solvers.dynamics.base.Integrator.energies` at the same state, if the
+        caller has them. When the J2 law is its block's only term (no zoned body: not
+        ``mono-zoned`` or ``graded``) and has no bulk viscosity, the block's
         ``stored`` and ``dissipation`` there are these numbers (the same calls on the same
         state): taken from them rather than computed twice.
         """

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ...io import ResultsFolder
-from ...solvers.static import solve_static
+from ...solvers.statics.static import solve_static
 from .report import write_folder
 from .result import PatchTestResult
 from .setup import build_problem, nodal

@@ -15,8 +15,8 @@ from ...contract import BandYieldWarning, CoarseYieldWarning, SimulationError
 from ...io import QuasiStaticRunWriter, ResultsFolder
 from ...problem.adapt import cell_rings
 from ...solvers import NewtonError, QuasiStaticSolver
-from ...solvers.adaptive import run_adaptive
-from ...solvers.yield_watch import BandYieldWatch
+from ...solvers.statics.adaptive import run_adaptive
+from ...solvers.system.yield_watch import BandYieldWatch
 from ..adaptive_options import fixed_patch
 from ..plastic_report import plastic_report
 from .result import HISTORY_KEYS, UNITS, PlateWithHoleResult

@@ -183,11 +183,11 @@ class MultiplierHistory:
     multiplier history against its largest value (the Arlequin Taylor bar's criterion ≤ 0.05).
 
     The rows are kept in float32 (N), in the mediator's own basis. When the integrator solves
-    for the multipliers in another basis (:class:`~arlequin.solvers.row_basis.Multipliers`), a
-    step keeps the scheme's stacked multipliers and :attr:`chunk` steps are converted in one
-    solve: the same numbers as a conversion at every step, which cost 41 µs of each Arlequin
-    Taylor bar step in a warm loop (most of the 8 to 11 s that the 20-cells run spent outside
-    its steps).
+    for the multipliers in another basis
+    (:class:`~arlequin.solvers.dynamics.row_basis.Multipliers`), a step keeps the scheme's
+    stacked multipliers and :attr:`chunk` steps are converted in one solve: the same numbers as
+    a conversion at every step, which cost 41 µs of each Arlequin Taylor bar step in a warm loop
+    (most of the 8 to 11 s that the 20-cells run spent outside its steps).
     """
 
     #: Steps converted together (their scheme multipliers in float64 until then).

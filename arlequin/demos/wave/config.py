@@ -7,7 +7,7 @@ from dataclasses import dataclass
 from typing import Any, ClassVar
 
 from ...solvers import get_integrator
-from ...solvers.controllers import check_step
+from ...solvers.dynamics.controllers import check_step
 from ..config import DemoConfig, option
 
 __all__ = ["INTEGRATORS", "WaveConfig"]

@@ -35,7 +35,7 @@ from ...solvers import (
     solve,
     stable_time_step,
 )
-from ...solvers.controllers import check_step
+from ...solvers.dynamics.controllers import check_step
 from .report import write_results
 from .result import WaveResult
 from .setup import H, WaveSetup, build_wave

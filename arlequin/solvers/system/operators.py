@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from ..contract import (
+from ...contract import (
     CapabilityError,
     ConstraintError,
     ContractError,
@@ -31,9 +31,9 @@ from ..contract import (
     check_protocol,
     is_linear,
 )
-from ..problem.system import Block, BlockTerm, CoupledSystem
-from .csr import CsrProduct
-from .timing import SWITCH
+from ...linalg.csr import CsrProduct
+from ...linalg.timing import SWITCH
+from ...problem.system import Block, BlockTerm, CoupledSystem
 
 __all__ = ["TANGENTS", "SystemOperators", "as_system", "as_vector"]
 
@@ -325,7 +325,7 @@ class SystemOperators:
         return cache[blocks]
 
     def _stiffness_times(self, u: np.ndarray) -> np.ndarray:
-        """K u (N) with the linear stiffness, compiled (:class:`~arlequin.solvers.csr.CsrProduct`,
+        """K u (N) with the linear stiffness, compiled (:class:`~arlequin.linalg.csr.CsrProduct`,
         the floats of ``K @ u``), built on first use and again if the matrix is replaced."""
         product = self.__dict__.get("_stiffness_product")
         if product is None or product[0] is not self.stiffness:

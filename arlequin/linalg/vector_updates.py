@@ -10,7 +10,7 @@ default: no fused multiply-add), so the results are those of the numpy lines bit
 (tested against them).
 
 The kick, the predictor, the velocity at t and the finite-state check are timed as linear
-algebra by the step timers (:func:`~arlequin.solvers.timing.vector_updates_done`: they run
+algebra by the step timers (:func:`~arlequin.linalg.timing.vector_updates_done`: they run
 outside the step's other timed regions); the internal work's products are timed with the energy
 bookkeeping by their caller.
 
@@ -66,7 +66,7 @@ def subtract_scaled_at(v, cols, scale, x):
     ``scale`` and ``x`` float64 (k,)): the bits of the numpy line (each entry's product, then
     its subtraction) in one pass, without its gather, temporary and scatter. The indices are
     not checked: :meth:`EqualityRows.subtract_at_cols
-    <arlequin.solvers.rows.EqualityRows.subtract_at_cols>` calls it with its own, valid by
+    <arlequin.solvers.system.rows.EqualityRows.subtract_at_cols>` calls it with its own, valid by
     construction."""
     for j in range(cols.size):
         c = cols[j]

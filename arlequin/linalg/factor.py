@@ -6,7 +6,7 @@ singularity into a :class:`~arlequin.contract.ConstraintError` that names the of
 :func:`factor_rows` factorises the impulse matrix B M⁻¹ Bᵀ of constraint rows, by
 :class:`LowRankSplitSolver` when a few dofs shared by many rows make it dense, or
 :class:`DiagonalLowRankSolver` when every row has a dof of its own (rows in their pivot basis,
-:mod:`arlequin.solvers.row_basis`).
+:mod:`arlequin.solvers.dynamics.row_basis`).
 """
 
 from __future__ import annotations
@@ -305,7 +305,7 @@ class DiagonalLowRankSolver:
     row, a coarse mesh's neighbours; dense groups up to 300 dofs, SuperLU beyond), then per
     solve two products with U and C's triangular solves. Rows in their pivot basis
     (v_F + P v_O = 0: the fine mediator of a nested patch,
-    :mod:`arlequin.solvers.row_basis`) and single-dof rows have this form: on the ball
+    :mod:`arlequin.solvers.dynamics.row_basis`) and single-dof rows have this form: on the ball
     impact's equality rows (two bands and the axes, 4,592 rows, k = 450 in four groups) a
     solve takes 0.06 ms against 0.75 ms for the sparse LU of the rows as assembled. C's
     eigenvalues are at least 1: S is positive definite whatever B (the private columns make

@@ -16,20 +16,20 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from ..contract import csr_pattern, csr_with_data, same_pattern
-from ..problem.system import LinearConstraint
-from .block_sums import kind_block_powers, scattered_block_powers, touched_index
-from .csr import (
+from ...contract import csr_pattern, csr_with_data, same_pattern
+from ...linalg.block_sums import kind_block_powers, scattered_block_powers, touched_index
+from ...linalg.csr import (
     PARALLEL_MIN_NNZ,
     CsrProduct,
     csr_times,
     csr_times_subtract_scaled,
     subtract_scaled_transposed,
 )
-from .linalg import factor_checked
+from ...linalg.factor import factor_checked
+from ...linalg.timing import energy_products_done, timer_start
+from ...linalg.vector_updates import subtract_scaled_at
+from ...problem.system import LinearConstraint
 from .operators import SystemOperators
-from .timing import energy_products_done, timer_start
-from .vector_updates import subtract_scaled_at
 
 logger = logging.getLogger(__name__)
 
@@ -225,7 +225,7 @@ def _compiled_rows(g: sp.csr_matrix, *vectors: np.ndarray) -> bool:
 
 def rows_times(g: sp.csr_matrix, x: np.ndarray) -> np.ndarray:
     """``G x`` (m,) of CSR rows G (m, n): scipy's product bit for bit
-    (:func:`~arlequin.solvers.csr.csr_times`), without its Python-level checks (a few µs, each
+    (:func:`~arlequin.linalg.csr.csr_times`), without its Python-level checks (a few µs, each
     status iteration of a contact step)."""
     if not (_compiled_rows(g, x) and x.shape == (g.shape[1],)):
         return g @ x
@@ -238,7 +238,7 @@ def subtract_transposed(g: sp.csr_matrix, lam: np.ndarray, scale: np.ndarray, v:
                         scratch: np.ndarray) -> None:  # fmt: skip
     """``v −= scale ⊙ (Gᵀ λ)`` in place for CSR rows G (m, n), multipliers λ (m,) and a scale
     (n,) (M⁻¹): the bits of ``v -= scale * transposed_times(g, lam)`` on G's columns alone
-    (:func:`~arlequin.solvers.csr.subtract_scaled_transposed`); ``scratch`` (n,) zeros, left
+    (:func:`~arlequin.linalg.csr.subtract_scaled_transposed`); ``scratch`` (n,) zeros, left
     zeros."""
     n = g.shape[1]
     sizes = lam.shape == (g.shape[0],) and v.shape == scale.shape == scratch.shape == (n,)
@@ -282,7 +282,7 @@ def unilateral_block_powers(
     """:func:`unilateral_block_power` for one or two vectors x (n,), shape (len(xs), n_blocks),
     on the dofs the rows touch only (the same powers up to round-off: the force Gᵀλ is summed
     on those dofs alone), in one compiled pass
-    (:func:`~arlequin.solvers.block_sums.scattered_block_powers`: the floats of
+    (:func:`~arlequin.linalg.block_sums.scattered_block_powers`: the floats of
     ``np.bincount`` for the force and :func:`signed_block_sums` for each vector)."""
     nb = len(ops.blocks)
     x1, x2 = _vectors(xs, ops.n, "unilateral_block_powers")
@@ -434,7 +434,7 @@ class EqualityRows:
     def subtract_at_cols(self, v: np.ndarray, scale: np.ndarray, x: np.ndarray) -> None:
         """``v[self.cols] −= scale ⊙ x`` in place (v (n,), scale and x on the touched dofs):
         the equality rows' impulse M⁻¹ Bᵀλ, one compiled pass bit for bit the numpy line
-        (:func:`~arlequin.solvers.vector_updates.subtract_scaled_at`)."""
+        (:func:`~arlequin.linalg.vector_updates.subtract_scaled_at`)."""
         k = self.cols.shape
         fast = (v.shape == (self.n,) and scale.shape == x.shape == k and v.flags.c_contiguous
                 and v.dtype == scale.dtype == x.dtype == np.float64)  # fmt: skip
@@ -446,7 +446,7 @@ class EqualityRows:
     def subtract_impulse(self, v: np.ndarray, scale: np.ndarray, lam: np.ndarray) -> None:
         """``v[self.cols] −= scale ⊙ (Bᵀλ)`` in place (v (n,), scale on the touched dofs, λ
         (m,)): the equality rows' impulse M⁻¹ Bᵀλ, one compiled pass
-        (:func:`~arlequin.solvers.csr.csr_times_subtract_scaled`), the floats of
+        (:func:`~arlequin.linalg.csr.csr_times_subtract_scaled`), the floats of
         ``subtract_at_cols(v, scale, transpose_times(lam))`` without the product's vector."""
         a = self.transpose_times
         fast = (a.nnz < PARALLEL_MIN_NNZ and v.shape == (self.n,) and v.flags.c_contiguous
@@ -462,9 +462,9 @@ class EqualityRows:
         """Accumulate into ``out`` (len(vs), 2, n_blocks) the powers ``−Σ_{j∈b} x_j
         (B_cᵀλ_c)_j`` of the coupling rows (``out[i, 0]``) and of the others (``out[i, 1]``)
         for one or two vectors x (n,) of ``vs``: one compiled pass over the touched dofs
-        (:func:`~arlequin.solvers.block_sums.kind_block_powers`; a zero ``out`` receives the
+        (:func:`~arlequin.linalg.block_sums.kind_block_powers`; a zero ``out`` receives the
         floats of each kind's Bᵀλ summed alone, then
-        :func:`~arlequin.solvers.block_sums.signed_block_sums` for each vector and kind)."""
+        :func:`~arlequin.linalg.block_sums.signed_block_sums` for each vector and kind)."""
         x1, x2 = _vectors(vs, self.n, "add_block_powers")
         if out.shape != (len(vs), 2, self.n_blocks):
             raise ValueError(f"add_block_powers: out of shape ({len(vs)}, 2, {self.n_blocks}), "

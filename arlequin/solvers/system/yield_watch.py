@@ -14,7 +14,7 @@ import warnings
 from collections.abc import Callable
 from typing import Any
 
-from ..contract import BandYieldWarning
+from ...contract import BandYieldWarning
 
 __all__ = ["BandYieldWatch"]
 

@@ -61,9 +61,9 @@ def kind_block_powers(indptr, indices, data, other, lam, x1, x2, n_x, has, idx, 
 
     For each touched dof k (row k of Bᵀ), the forces of the coupling rows (``other[r]`` 0) and
     of the others (1), ``f = Σ_p data[p] lam[r]`` over the row's entries in stored order from
-    zero (:func:`~arlequin.solvers.csr.csr_times` on each kind's Bᵀ alone), then
+    zero (:func:`~arlequin.linalg.csr.csr_times` on each kind's Bᵀ alone), then
     ``out[i, kind, block[k]] -= f * x_i[idx[k]]`` for i < n_x: the floats of
-    :class:`~arlequin.solvers.csr.CsrProduct` per kind and :func:`signed_block_sums` per kind
+    :class:`~arlequin.linalg.csr.CsrProduct` per kind and :func:`signed_block_sums` per kind
     and vector, bit for bit.
 
     Parameters

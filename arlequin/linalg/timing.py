@@ -17,10 +17,10 @@ What is timed, with ``time.perf_counter`` (or the thread's CPU time, ``clock="th
   Gᵀλ·v, of the external, friction and damping forces, and the internal work's Δu·f̄), also
   counted apart in ``energy_products``; and the explicit step's compiled full-length vector
   updates (the kick v⁻ + Δt̄ a, the predictor u + Δt v, the velocity at t, the finite-state
-  check's Σx², :mod:`arlequin.solvers.vector_updates`) and its diagonal solve M⁻¹ f, dense
+  check's Σx², :mod:`arlequin.linalg.vector_updates`) and its diagonal solve M⁻¹ f, dense
   linear algebra of one pass each, also counted apart in ``vector_updates`` (with the
   finite-state check of any scheme stepped inside the timer);
-* ``step``: :meth:`Integrator.step <arlequin.solvers.base.Integrator.step>` as a whole, so
+* ``step``: :meth:`Integrator.step <arlequin.solvers.dynamics.base.Integrator.step>` as a whole, so
   ``other = step − kernel − linear_algebra`` is the Python layer around them (the overhead).
 """
 

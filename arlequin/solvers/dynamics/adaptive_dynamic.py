@@ -1,6 +1,6 @@
 """Adaptive patches in explicit runs (``solve(problem, "explicit", ..., adapt=AdaptivePatch())``).
 
-The time loop of :func:`~arlequin.solvers.driver.solve` asks :class:`DynamicAdapter` after every
+The time loop of :func:`~arlequin.solvers.run.driver.solve` asks :class:`DynamicAdapter` after every
 step whether a check is due (:meth:`DynamicAdapter.due`: every ``adapt.every`` steps, or every
 ``adapt.interval`` seconds of simulated time, at the initial state and at the last step; a
 multi-time-step scheme at its macro times only). At a check the adaptation object
@@ -45,7 +45,7 @@ from typing import Any
 
 import numpy as np
 
-from ..contract import SimulationError
+from ...contract import SimulationError
 
 __all__ = [
     "DynamicAdapter",

@@ -35,11 +35,11 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..contract import is_unilateral
-from ..problem.system import CoupledSystem
-from .linalg import factor_checked
-from .operators import SystemOperators
-from .rows import EqualityRows
+from ...contract import is_unilateral
+from ...linalg.factor import factor_checked
+from ...problem.system import CoupledSystem
+from ..system.operators import SystemOperators
+from ..system.rows import EqualityRows
 
 __all__ = [
     "DEFAULT_SAFETY",

@@ -2,7 +2,7 @@
 
 Integrator modules register their classes with :func:`register` when imported (the package
 ``arlequin.solvers`` imports them all); :func:`get_integrator` accepts a registered name or
-an :class:`~arlequin.solvers.base.Integrator` subclass.
+an :class:`~arlequin.solvers.dynamics.base.Integrator` subclass.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Compiled dense factor of the impulse matrix of a few active unilateral rows.
 
-The explicit step's impulse solve (:class:`~arlequin.solvers.impulses.ImpulseSolver`) adds the
+The explicit step's impulse solve (:class:`~arlequin.linalg.impulses.ImpulseSolver`) adds the
 active contact rows G_A to the factorised equality rows by a Schur complement. On a deforming
 contact the rows are new at every step, so the complement is built and factorised at every
 step:
@@ -15,9 +15,9 @@ arithmetic of a dozen rows; here it is one compiled call, and the solve another.
 
 The floats differ from LAPACK's by round-off only (the order of the sums). The tests of
 positive definiteness (:func:`cholesky_checked`, also the factorisation of
-:class:`~arlequin.solvers.impulses.ImpulseSolver`'s other dense paths): a non-finite entry, a
+:class:`~arlequin.linalg.impulses.ImpulseSolver`'s other dense paths): a non-finite entry, a
 non-positive pivot, or a pivot U_jj² below 1e-14 |S_jj| (a row dependent on the others to
-round-off; :class:`~arlequin.solvers.linalg.ScaledLU` applies 1e-14 to its pivots after a
+round-off; :class:`~arlequin.linalg.factor.ScaledLU` applies 1e-14 to its pivots after a
 diagonal scaling) is refused.
 
 numba compiles on first call (cached on disk, ``cache=True``).

@@ -26,8 +26,8 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..contract import SimulationError
-from .yield_watch import BandYieldWatch
+from ...contract import SimulationError
+from ..system.yield_watch import BandYieldWatch
 
 __all__ = ["AdaptableSolver", "run_adaptive"]
 
@@ -37,7 +37,7 @@ logger = logging.getLogger(__name__)
 class AdaptableSolver:
     """What :func:`run_adaptive` needs of a quasi-static solver besides ``replace_system``
     and ``resolve``: to undo a step, the least-squares multipliers of moved fields, the
-    stored energy (a mixin of :class:`~arlequin.solvers.quasi_static.QuasiStaticSolver`)."""
+    stored energy (a mixin of :class:`~arlequin.solvers.statics.quasi_static.QuasiStaticSolver`)."""
 
     _SNAPSHOT = ("u", "mu", "states", "t", "dt", "status", "_previous", "_first_stiffness",
                  "_last_stiffness")  # fmt: skip
@@ -125,14 +125,14 @@ def run_adaptive(
     -------
     QuasiStaticResult
         With ``adaptations``, ``max_coarse_yield_ratio``, ``band_plastic_fraction`` (the
-        accepted steps' gluing bands, :class:`~arlequin.solvers.yield_watch.BandYieldWatch`)
+        accepted steps' gluing bands, :class:`~arlequin.solvers.system.yield_watch.BandYieldWatch`)
         and the final ``problem``.
 
     Raises
     ------
     SimulationError
-        A Newton failure (:class:`~arlequin.solvers.quasi_static.NewtonError`) or the patch's
-        cap (:class:`~arlequin.problem.adapt.PatchLimitError`); ``err.result`` holds every
+        A Newton failure (:class:`~arlequin.solvers.statics.quasi_static.NewtonError`) or the
+        patch's cap (:class:`~arlequin.problem.adapt.PatchLimitError`); ``err.result`` holds every
         converged step.
     """
     watch = BandYieldWatch(lambda: adapt.problem)

@@ -19,8 +19,8 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..contract import is_linear
-from ..problem.system import CoupledSystem
+from ...contract import is_linear
+from ...problem.system import CoupledSystem
 
 logger = logging.getLogger(__name__)
 
@@ -289,8 +289,8 @@ def solve_static(problem, t: float = 0.0) -> StaticResult:
     A problem whose models are all linear is one sparse solve of the saddle point. A problem
     with a nonlinear model (an elastoplastic patch) is never given its linear answer: it is
     solved by Newton with the consistent tangents, as one load step of
-    :func:`~arlequin.solvers.quasi_static.solve_quasi_static` (cut automatically where Newton
-    needs it) from the unloaded state to the loads at ``t``; a path-dependent material then
+    :func:`~arlequin.solvers.statics.quasi_static.solve_quasi_static` (cut automatically where
+    Newton needs it) from the unloaded state to the loads at ``t``; a path-dependent material then
     follows a proportional path (call ``solve_quasi_static`` for another path, for the history
     of the steps, or to resume). The strain energies of its nonlinear blocks are not given.
 

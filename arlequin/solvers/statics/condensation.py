@@ -21,12 +21,13 @@ does not apply or would not pay (no linear block, no nonlinear one, linear dofs 
 mediator rows, or S too large), every iteration factors the whole saddle point (the reference
 path, ``condense=False``).
 
-Constraint rows are scaled to the stiffness (as in :mod:`arlequin.solvers.static`): their
+Constraint rows are scaled to the stiffness (as in :mod:`arlequin.solvers.statics.static`): their
 entries (m² for L2 coupling) can be 1e13 times smaller than the stiffness's (N/m).
 
-The systems of the iterations are factorised by a :class:`~arlequin.solvers.direct.
-SparseDirectSolver` (``linear_solver``: SuperLU, or PARDISO which keeps its symbolic analysis
-from one iteration to the next); K_LL, factorised once, stays with SuperLU.
+The systems of the iterations are factorised by a
+:class:`~arlequin.linalg.direct.SparseDirectSolver` (``linear_solver``: SuperLU, or PARDISO which
+keeps its symbolic analysis from one iteration to the next); K_LL, factorised once, stays with
+SuperLU.
 """
 
 from __future__ import annotations
@@ -38,9 +39,9 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..problem.system import CoupledSystem
-from .direct import SparseDirectSolver
-from .operators import SystemOperators
+from ...linalg.direct import SparseDirectSolver
+from ...problem.system import CoupledSystem
+from ..system.operators import SystemOperators
 
 __all__ = ["MAX_CONDENSED_ENTRIES", "MIN_LINEAR_SHARE", "SaddleSolver"]
 
@@ -64,7 +65,7 @@ class SaddleSolver:
     condense : bool
         Condense the linear blocks (see the module docstring).
     linear_solver : {"auto", "superlu", "pardiso"}
-        The backend of the iterations' factorisations (:mod:`arlequin.solvers.direct`).
+        The backend of the iterations' factorisations (:mod:`arlequin.linalg.direct`).
 
     Attributes
     ----------

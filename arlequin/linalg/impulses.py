@@ -12,7 +12,7 @@ import scipy.sparse as sp
 
 from ..contract import ConstraintError, same_pattern
 from .active_schur import ActiveSchur, cholesky_checked
-from .linalg import dense_cho_solve, factor_checked, factor_rows
+from .factor import dense_cho_solve, factor_checked, factor_rows
 
 __all__ = ["ImpulseSolver"]
 
@@ -20,7 +20,7 @@ __all__ = ["ImpulseSolver"]
 class ImpulseSolver:
     """Solves (B M⁻¹ Bᵀ) Λ = r for the equality rows E plus the active unilateral rows A.
 
-    The equality block S_EE is factorised once (:func:`~arlequin.solvers.linalg.factor_rows`:
+    The equality block S_EE is factorised once (:func:`~arlequin.linalg.factor.factor_rows`:
     by a low-rank split under a fine mediator); active rows enter by a Schur complement
     (dense, cached for the last active rows, keyed by their content), or by a sparse
     factorisation of the whole matrix when there are many of them.
@@ -188,8 +188,8 @@ class ImpulseSolver:
     @staticmethod
     def _cholesky(schur: np.ndarray, m_a: int) -> tuple[np.ndarray, bool]:
         """Upper Cholesky factor of the dense (Schur complement) matrix of the ``m_a`` active
-        rows, as ``(U, False)`` for :func:`~arlequin.solvers.linalg.dense_cho_solve`
-        (:func:`~arlequin.solvers.active_schur.cholesky_checked`: raises
+        rows, as ``(U, False)`` for :func:`~arlequin.linalg.factor.dense_cho_solve`
+        (:func:`~arlequin.linalg.active_schur.cholesky_checked`: raises
         :class:`ConstraintError` if it is not finite or positive definite, or a row depends
         on the others)."""
         return cholesky_checked(schur), False

@@ -3,7 +3,7 @@
 An integrator sees a :class:`arlequin.problem.system.CoupledSystem` (mass, internal force, tangent,
 external force at time t, constraint rows with multipliers), never meshes. :meth:`Integrator.step`
 owns the time ``t``, the step sizes and the ``status``; it calls the scheme's ``_step_impl``.
-The size of each step comes from a step controller (:mod:`arlequin.solvers.controllers`) or
+The size of each step comes from a step controller (:mod:`arlequin.solvers.dynamics.controllers`) or
 from the caller (``step(dt)``), shortened to land exactly on the requested stop times.
 
 State is committed, never mutated: model states at quadrature points and unilateral constraint
@@ -23,19 +23,19 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from ..contract import (
+from ...contract import (
     ContractError,
     SimulationError,
     StateError,
     UnilateralConstraint,
     is_unilateral,
 )
-from ..problem.system import CoupledSystem, LinearConstraint
+from ...linalg.timing import SWITCH
+from ...linalg.vector_updates import sum_of_squares
+from ...problem.system import CoupledSystem, LinearConstraint
+from ..system.operators import SystemOperators, as_system, as_vector
+from ..system.rows import EqualityRows, consistent_initial_state, scatter_active, stack_active
 from .controllers import StepController, as_controller, check_step
-from .operators import SystemOperators, as_system, as_vector
-from .rows import EqualityRows, consistent_initial_state, scatter_active, stack_active
-from .timing import SWITCH
-from .vector_updates import sum_of_squares
 
 __all__ = ["STATUSES", "Integrator", "IntegratorSnapshot"]
 
@@ -97,7 +97,7 @@ class Integrator:
         :class:`~arlequin.contract.UnilateralConstraint` objects (unilateral objects found in
         ``system.constraints`` are used as well).
     step_controller : StepController, float or callable, optional
-        Chooses each step (see :mod:`arlequin.solvers.controllers`); overrides ``dt``.
+        Chooses each step (see :mod:`arlequin.solvers.dynamics.controllers`); overrides ``dt``.
     consistent_initial : bool
         Project u0 and v0 (mass metric) onto the equality rows (coupling-consistent initial
         conditions); the correction's size is logged.

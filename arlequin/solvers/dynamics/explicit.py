@@ -43,17 +43,17 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from ..contract import SimulationError, capabilities
+from ...contract import SimulationError, capabilities
+from ...linalg.impulses import ImpulseSolver
+from ...linalg.timing import SWITCH, energy_products_done, timer_start, vector_updates_done
+from ...linalg.vector_updates import interpolated, scaled_plus, work_products
+from ..system.rows import EqualityRows, rows_times, subtract_transposed, unilateral_block_powers
 from .base import Integrator
 from .controllers import FixedStep, StepController
 from .damping import RayleighDamping
-from .impulses import ImpulseSolver
 from .registry import register
 from .row_basis import ImpulseBasis
-from .rows import EqualityRows, rows_times, subtract_transposed, unilateral_block_powers
 from .stability import DEFAULT_SAFETY, StableStep, check_time_step, stable_time_step
-from .timing import SWITCH, energy_products_done, timer_start, vector_updates_done
-from .vector_updates import interpolated, scaled_plus, work_products
 
 __all__ = ["DEFAULT_SAFETY", "CentralDifference"]
 
@@ -73,15 +73,15 @@ class CentralDifference(Integrator):
     safety : float
         Ratio of the default step to the critical step (default 0.9).
     stable_method : {"coupled", "blocks", "gershgorin"}
-        Estimate of the critical step (see :mod:`arlequin.solvers.stability`).
+        Estimate of the critical step (see :mod:`arlequin.solvers.dynamics.stability`).
     check_dt : bool
         Refuse a step above the critical one (default True).
     damping : RayleighDamping, optional
-        Rayleigh damping C = α M + β K₀ (:mod:`arlequin.solvers.damping`): the force
+        Rayleigh damping C = α M + β K₀ (:mod:`arlequin.solvers.dynamics.damping`): the force
         −C v^{n−1/2} at t_n, the critical step reduced accordingly, the dissipated energy in
         ``energies()["damping_work"]``. Default none.
     **kwargs
-        See :class:`arlequin.solvers.base.Integrator` (``step_controller`` among them: e.g.
+        See :class:`arlequin.solvers.dynamics.base.Integrator` (``step_controller`` among them: e.g.
         :class:`~arlequin.solvers.CriticalFraction` to follow a changing configuration).
 
     Attributes

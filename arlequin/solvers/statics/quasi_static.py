@@ -23,10 +23,10 @@ next step grows back (× ``growth``, never beyond the nominal step). When the st
 further (``min_step``), the run stops and says why: a limit load (the structure's load-carrying
 capacity: the incremental stiffness had dropped, or the tangent became singular), a
 ``StateError``, or a Newton failure. Linear blocks (the coarse elastic models) are condensed
-once for the whole run (:mod:`arlequin.solvers.condensation`): each Newton iteration factors
+once for the whole run (:mod:`arlequin.solvers.statics.condensation`): each Newton iteration factors
 only the nonlinear blocks and the multipliers. The factorisations use a sparse direct solver
 (``linear_solver``: SuperLU, or PARDISO where pypardiso is installed, which keeps its symbolic
-analysis from one iteration of a load step to the next: :mod:`arlequin.solvers.direct`).
+analysis from one iteration of a load step to the next: :mod:`arlequin.linalg.direct`).
 
 Timings (failed attempts included): the models' internal forces, return maps and tangents, the
 factorisations, the solves, the rest, in :attr:`QuasiStaticSolver.timings` and the result's.
@@ -44,12 +44,13 @@ from typing import Any
 
 import numpy as np
 
-from ..contract import StateError
+from ...contract import StateError
+from ...linalg.direct import resolve_linear_solver
+from ..system.constraints import is_unilateral
+from ..system.operators import SystemOperators, as_system, as_vector
+from ..system.yield_watch import BandYieldWatch
 from .adaptive import AdaptableSolver, run_adaptive
 from .condensation import SaddleSolver
-from .constraints import is_unilateral
-from .direct import resolve_linear_solver
-from .operators import SystemOperators, as_system, as_vector
 from .quasi_static_result import (
     STATUSES,
     CoarseYieldWatch,
@@ -59,7 +60,6 @@ from .quasi_static_result import (
     QuasiStaticResult,
     QuasiStaticStep,
 )
-from .yield_watch import BandYieldWatch
 
 __all__ = [
     "STATUSES",
@@ -114,7 +114,7 @@ class QuasiStaticSolver(AdaptableSolver):
         Condense the linear blocks once (True) or factor the whole saddle point at every
         iteration (False, the reference).
     linear_solver : {"auto", "superlu", "pardiso"}
-        The sparse direct solver of the Newton systems (:mod:`arlequin.solvers.direct`):
+        The sparse direct solver of the Newton systems (:mod:`arlequin.linalg.direct`):
         ``"auto"`` is PARDISO where the optional pypardiso is installed, else SuperLU.
     reference_time : float
         With ``proportional``, the time (s) at which the system's loads and prescribed values
@@ -434,7 +434,7 @@ class QuasiStaticSolver(AdaptableSolver):
             setattr(self, name, snap[name])
         self.history = list(self.history)
 
-    # -- adaptation (arlequin.problem.adapt, driven by arlequin.solvers.adaptive) ------------
+    # -- adaptation (arlequin.problem.adapt, driven by arlequin.solvers.statics.adaptive) ---------
     def replace_system(self, system: Any, u: np.ndarray, states: dict[str, list[Any]]) -> None:
         """Go on with another system (a grown patch) from the fields ``u`` and ``states`` moved
         onto it at the same load factor (blocks missing from ``states``: initial states); the
@@ -551,8 +551,8 @@ def solve_quasi_static(
         Called likewise; returning True stops the run (status ``"stopped"``).
     adapt : AdaptivePatch, optional
         A patch that grows where the material yields (:mod:`arlequin.problem.adapt`, driven by
-        :func:`arlequin.solvers.adaptive.run_adaptive`); listeners with an ``on_adapt(solver,
-        adapt)`` member are told of each growth.
+        :func:`arlequin.solvers.statics.adaptive.run_adaptive`); listeners with an
+        ``on_adapt(solver, adapt)`` member are told of each growth.
     **options
         Passed to :class:`QuasiStaticSolver` (``proportional``, ``tol``, ``max_iterations``,
         ``min_step``, ``growth``, ``line_search``, ``condense``, ``linear_solver``,

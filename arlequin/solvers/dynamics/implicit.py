@@ -41,12 +41,12 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from ..contract import SimulationError
+from ...contract import SimulationError
+from ...linalg.factor import factor_checked
+from ..system.rows import rows_key, unilateral_block_power
 from .base import Integrator
 from .controllers import FixedStep, StepController
-from .linalg import factor_checked
 from .registry import register
-from .rows import rows_key, unilateral_block_power
 from .stability import DEFAULT_SAFETY, stable_time_step
 
 __all__ = ["HHTAlpha", "ImplicitIntegrator", "Newmark", "ThetaScheme"]

@@ -15,7 +15,7 @@ in the fine space, gives the interpolation of the coarse field at the band's fin
 3 entries a row in 2D), so that the rows say v_F = −P v_O. P is computed by sparse solves and
 checked by its residual T P − R_O; a constraint whose P is not sparse (a non-nested patch, a
 coarse mediator) keeps its rows. The impulse matrix of R' is diagonal plus low rank
-(:class:`~arlequin.solvers.linalg.DiagonalLowRankSolver`), where R's was as dense as the
+(:class:`~arlequin.linalg.factor.DiagonalLowRankSolver`), where R's was as dense as the
 band's Gram matrix squared.
 
 The multipliers of the original rows are Λ_R = T⁻ᵀΛ'_R and Λ_S = Λ'_S − D_s⁻¹ R_JᵀΛ_R, computed
@@ -34,9 +34,9 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..problem.system import LinearConstraint
-from .operators import SystemOperators
-from .rows import EqualityRows
+from ...problem.system import LinearConstraint
+from ..system.operators import SystemOperators
+from ..system.rows import EqualityRows
 
 __all__ = ["ImpulseBasis", "Multipliers"]
 

@@ -1,5 +1,5 @@
 """What a quasi-static run gives back: its converged steps, its result, its failure
-(:func:`arlequin.solvers.quasi_static.solve_quasi_static`). SI units.
+(:func:`arlequin.solvers.statics.quasi_static.solve_quasi_static`). SI units.
 
 Each converged step keeps a record of its Newton iterations (:class:`NewtonIteration`): the
 relative residuals as the solver measures them and how many quadrature points crossed the
@@ -21,8 +21,8 @@ from typing import Any
 
 import numpy as np
 
-from ..contract import CoarseYieldWarning, SimulationError
-from ..problem.system import CoupledSystem
+from ...contract import CoarseYieldWarning, SimulationError
+from ...problem.system import CoupledSystem
 
 __all__ = [
     "STATUSES",
@@ -198,7 +198,8 @@ class QuasiStaticResult:
     timings : dict
         Seconds (wall time) of the load steps: ``"constitutive_and_tangent_s"``,
         ``"factorisation_s"``, ``"solve_s"``, ``"other_s"``
-        (:attr:`QuasiStaticSolver.timings <arlequin.solvers.quasi_static.QuasiStaticSolver>`).
+        (:attr:`QuasiStaticSolver.timings
+        <arlequin.solvers.statics.quasi_static.QuasiStaticSolver>`).
     """
 
     status: str
@@ -218,7 +219,7 @@ class QuasiStaticResult:
     adaptations: list[Any] = field(default_factory=list)
     max_coarse_yield_ratio: float | None = None
     #: largest share of a J2 patch's gluing band that was plastic after a converged step
-    #: (None: no J2 patch watched; :class:`~arlequin.solvers.yield_watch.BandYieldWatch`)
+    #: (None: no J2 patch watched; :class:`~arlequin.solvers.system.yield_watch.BandYieldWatch`)
     band_plastic_fraction: float | None = None
     problem: Any = field(default=None, repr=False)
     linear_solver: str = "superlu"

@@ -89,7 +89,7 @@ class DynamicResult:
         zeros without :class:`~arlequin.solvers.RayleighDamping`.
     band_plastic_fraction : float or None
         The largest share of a J2 patch's gluing band that was plastic at a recorded sample
-        (None: no J2 patch; :class:`~arlequin.solvers.yield_watch.BandYieldWatch`).
+        (None: no J2 patch; :class:`~arlequin.solvers.system.yield_watch.BandYieldWatch`).
     stored, dissipation : dict
         Block name -> stored energy and accumulated plastic dissipation (J), shape (n_rec,),
         of the models that offer them (``stored_energy_of_state``, ``plastic_dissipation``);

@@ -2,7 +2,7 @@
 
 It builds the integrator (a registry name or a class), tells it the stop times (the requested
 output times ``t_eval`` and the end time, which the steps land on exactly), steps it, and records
-through a :class:`~arlequin.solvers.recorder.Recorder` into a :class:`DynamicResult`.
+through a :class:`~arlequin.solvers.run.recorder.Recorder` into a :class:`DynamicResult`.
 """
 
 from __future__ import annotations
@@ -16,15 +16,15 @@ from typing import Any
 
 import numpy as np
 
-from ..contract import SimulationError
-from .adaptive_dynamic import DynamicAdapter, bind_adaptation, rebuild, run_adaptive_loop
-from .base import Integrator
-from .controllers import FixedStep
+from ...contract import SimulationError
+from ...linalg.threads import blas_threads
+from ..dynamics.adaptive_dynamic import DynamicAdapter, bind_adaptation, rebuild, run_adaptive_loop
+from ..dynamics.base import Integrator
+from ..dynamics.controllers import FixedStep
+from ..dynamics.registry import get_integrator
+from ..system.yield_watch import BandYieldWatch
 from .recorder import Recorder
-from .registry import get_integrator
 from .result import DynamicResult
-from .threads import blas_threads
-from .yield_watch import BandYieldWatch
 
 logger = logging.getLogger(__name__)
 
@@ -131,7 +131,7 @@ def solve(
         land on them exactly, and only the initial state and these times are recorded
         (``record_every`` is then ignored). Given without ``t_end``, the last one is the end.
     step_controller : StepController, float or callable, optional
-        Chooses each step (see :mod:`arlequin.solvers.controllers`), e.g.
+        Chooses each step (see :mod:`arlequin.solvers.dynamics.controllers`), e.g.
         ``CriticalFraction(0.9, every=20)`` or ``lambda integ: dt_n``.
     callback : callable, optional
         ``callback(integrator)`` at every recorded step (after the initial state too); returning
@@ -156,7 +156,7 @@ def solve(
         A nested patch of ``system`` (an :class:`~arlequin.ArlequinProblem`; a body's of a
         multi-body problem with a ``BodyAdaptation``) that grows where the material yields
         (:mod:`arlequin.problem.adapt`), checked every ``adapt.every`` steps or
-        ``adapt.interval`` s (:mod:`arlequin.solvers.adaptive_dynamic`); the result gains
+        ``adapt.interval`` s (:mod:`arlequin.solvers.dynamics.adaptive_dynamic`); the result gains
         ``adaptations``, ``max_coarse_yield_ratio`` and the final ``problem``. Not with
         ``restore``; extra ``constraints`` only with a ``BodyAdaptation`` that rebuilds them.
     **options

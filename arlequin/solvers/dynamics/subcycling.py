@@ -12,7 +12,7 @@ Berne and Martyna 1992), the velocity-Verlet splitting of the slow potential fro
 1. at a macro time T_n: ``v* = v^{n−½} + h̄ M⁻¹(f_ext − f_fast) − H̄ M⁻¹ f_slow(u^n)``;
 2. at the other fine times: ``v* = v^{n−½} + h̄ M⁻¹(f_ext − f_fast)``;
 3. then, at every fine time, the impulses of the one-step scheme
-   (:mod:`arlequin.solvers.explicit`) and the drift ``u += h v``.
+   (:mod:`arlequin.solvers.dynamics.explicit`) and the drift ``u += h v``.
 
 With m = 1 it is :class:`~arlequin.solvers.CentralDifference` exactly. The macro map is
 symplectic on the constraint subspace (the kicks and the projections of RATTLE preserve the
@@ -45,13 +45,13 @@ from typing import Any
 
 import numpy as np
 
-from ..contract import SimulationError
+from ...contract import SimulationError
+from ...linalg.vector_updates import scaled_plus
 from .base import Integrator
 from .controllers import check_step
 from .explicit import CentralDifference
 from .registry import register
 from .stability import DEFAULT_SAFETY
-from .vector_updates import scaled_plus
 
 __all__ = ["SubcycledCentralDifference"]
 

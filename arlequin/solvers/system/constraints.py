@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from ..contract import UnilateralConstraint, is_unilateral
+from ...contract import UnilateralConstraint, is_unilateral
 
 __all__ = [
     "InequalityState",
