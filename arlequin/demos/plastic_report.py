@@ -11,6 +11,8 @@ from __future__ import annotations
 
 from typing import Any
 
+from ..coupling.band_plasticity import band_cells, plastic_peak
+
 __all__ = ["PLASTIC_UNITS", "plastic_report"]
 
 #: The units of :func:`plastic_report`'s keys.
@@ -22,16 +24,16 @@ PLASTIC_UNITS = {
 }
 
 
-def plastic_report(problem: Any, block: str, state: Any,
+def plastic_report(problem: Any, block: str, model: Any, state: Any,
                    band_fraction: float | None) -> dict[str, Any]:  # fmt: skip
-    """The JSON keys of :data:`PLASTIC_UNITS` for the J2 model of ``block`` in its final
-    ``state`` (``problem.plastic_peak``) and the band's largest plastic share over the run
-    (None without a patch: a single mesh, or a graded one)."""
-    peak = problem.plastic_peak(block, state)
-    patch = block != "coarse"
+    """The JSON keys of :data:`PLASTIC_UNITS` for the J2 ``model`` (of ``block``) in its final
+    ``state`` and the band's largest plastic share over the run (None without a patch: a
+    single mesh, or a graded one with a J2 zone)."""
+    pc = next((pc for pc in getattr(problem, "couplings", ()) if pc.name == block), None)
+    peak = plastic_peak(model, state, None if pc is None else band_cells(pc))
     return {
-        "band_plastic_fraction": band_fraction if patch else None,
+        "band_plastic_fraction": band_fraction if pc is not None else None,
         "max_plastic_strain": None if peak is None else peak.value,
         "max_plastic_strain_position": None if peak is None else peak.position.tolist(),
-        "max_plastic_strain_in_band": peak.in_band if (peak is not None and patch) else None,
+        "max_plastic_strain_in_band": peak.in_band if (peak is not None and pc) else None,
     }
