@@ -137,6 +137,13 @@ class DynamicRunWriter:
         self._growths = getattr(self, "_growths", 0) + 1
         for bf in self.layout.blocks:
             if bf.mesh is not self._meshes.get(bf.name):
+                current = self.series.get(bf.name)
+                if current is not None and not current.times:
+                    # the outgoing mesh's series has no frame (a growth before the run's first
+                    # frame): removed, no field listed without data
+                    self._folder.remove_series(current)
+                    del self.series[bf.name]
+                    self._grown.discard(bf.name)
                 # opened at the next frame: growths between two frames leave no empty series
                 self._pending_series[bf.name] = (f"{self._prefix}{bf.name}_{self._growths}",
                                                  bf.mesh)  # fmt: skip
