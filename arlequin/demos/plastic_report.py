@@ -13,7 +13,7 @@ from typing import Any
 
 from ..coupling.band_plasticity import band_cells, plastic_peak
 
-__all__ = ["PLASTIC_UNITS", "plastic_report"]
+__all__ = ["PLASTIC_UNITS", "mark_peak", "plastic_report"]
 
 #: The units of :func:`plastic_report`'s keys.
 PLASTIC_UNITS = {
@@ -37,3 +37,17 @@ def plastic_report(problem: Any, block: str, model: Any, state: Any,
         "max_plastic_strain_position": None if peak is None else peak.position.tolist(),
         "max_plastic_strain_in_band": peak.in_band if (peak is not None and pc) else None,
     }
+
+
+def mark_peak(ax: Any, report: dict[str, Any]) -> None:
+    """Mark a picture's largest plastic strain (a :func:`plastic_report`): a cross at its
+    place (its first two coordinates: a 3D point shown on its plane's picture) and a line
+    under the title saying its value and whether it lies in the gluing band."""
+    where, value = report.get("max_plastic_strain_position"), report.get("max_plastic_strain")
+    if where is None or not value:
+        return
+    band = report.get("max_plastic_strain_in_band")
+    ax.plot(where[0], where[1], marker="x", color="red", markersize=9, mew=2)
+    note = {True: ", IN THE GLUING BAND (the coupling's)", False: ", outside the band",
+            None: ""}[band]  # fmt: skip
+    ax.set_xlabel(f"x: largest ε̄p {value:.3g}{note}", fontsize=8)

@@ -13,6 +13,7 @@ from ...geometry.facets import cyclic_quad_faces
 from ...io import ResultsFolder
 from ...problem.arlequin_problem import von_mises_of
 from ..adaptive_options import growth_title
+from ..plastic_report import mark_peak
 from .hill import cylinder_limit_load, sphere_limit_load, sphere_outer_displacement
 from .measures import von_mises
 from .result import PressureVesselResult
@@ -120,7 +121,8 @@ def plane_polygons(mesh: Any) -> tuple[np.ndarray, np.ndarray]:
 
 
 def plot_plastic_zone(setup: VesselSetup, state: Any, path: str,
-                      title: str = "plastic zone over the coarse mesh") -> None:  # fmt: skip
+                      title: str = "plastic zone over the coarse mesh",
+                      peak: dict[str, Any] | None = None) -> None:  # fmt: skip
     """ε̄p over the J2 model's cells at the end of the run, the coarse mesh's edges beside
     (a 3D run: on its symmetry plane z = 0, :func:`plane_polygons`)."""
     import matplotlib
@@ -143,6 +145,8 @@ def plot_plastic_zone(setup: VesselSetup, state: Any, path: str,
     if setup.meshes.coarse.p.shape[0] == 3:
         title += " (plane z = 0)"
     ax.set_title(title, fontsize=10)
+    if peak is not None:  # where the largest plastic strain lies, in the band or not
+        mark_peak(ax, peak)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
@@ -153,7 +157,7 @@ def write_pictures(folder: ResultsFolder, setup: VesselSetup, qs: Any,
     """The run's pictures in its results folder."""
     plot_pressure_curve(result, result.config, str(folder.picture("pressure_displacement")))
     state = qs.states[setup.plastic_block][0]
-    plot_plastic_zone(setup, state, str(folder.picture("plastic_zone")))
+    plot_plastic_zone(setup, state, str(folder.picture("plastic_zone")), peak=result.to_json())
     if result.adaptations:
         plot_patch_size(result, str(folder.picture("patch_size")))
 
