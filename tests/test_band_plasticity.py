@@ -123,10 +123,12 @@ def test_auto_mediator_resolution():
         arlequin.Patch(_j2(mesh), gluing_width=6e-3, mediator="both")
 
 
-def test_nested_3d_patch_defaults_show_the_materials_plastic_strain(coarse3d, mono3d):
-    """Nested patch to 4R, defaults: the largest plastic strain within 10% of the single fine
-    mesh's (measured −1.1%) at the same point, not in the band, the band elastic."""
-    patch = _nested(coarse3d, 4.0)
+@pytest.mark.parametrize("coupling", ["H1", "L2"])
+def test_nested_3d_patch_defaults_show_the_materials_plastic_strain(coarse3d, mono3d, coupling):
+    """Nested patch to 4R, defaults (H1, the default coupling, and L2): the largest plastic
+    strain within 10% of the single fine mesh's (measured −1.1% with both) at the same point,
+    not in the band, the band elastic."""
+    patch = _nested(coarse3d, 4.0, coupling=coupling)
     (peak, where), result, band_warnings, pc, state = _arlequin(coarse3d, patch)
     assert pc.mediator == "fine"  # 41 unheld band cells: "auto" takes the fine mediator
     assert unheld_band_cells(pc).size > 0
