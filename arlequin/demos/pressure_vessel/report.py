@@ -164,12 +164,15 @@ def write_pictures(folder: ResultsFolder, setup: VesselSetup, qs: Any,
 
 class AdaptationPictures:
     """A listener of an adaptive run: the plastic zone over the grown patch, one picture a
-    growth (``patch_K.png``, from the fields the growth started from, re-solved)."""
+    growth (``patch_K.png``, from the fields the growth started from, re-solved); ``count``
+    the growths so far (a resumed run: their pictures, on disk, listed again)."""
 
     def __init__(self, folder: ResultsFolder, setup: VesselSetup,
-                 history: dict[str, list[Any]]) -> None:  # fmt: skip
+                 history: dict[str, list[Any]], count: int = 0) -> None:  # fmt: skip
         # history: the recorder's, whose last pressure is the committed state's (the growth's)
-        self.folder, self.setup, self.history, self.count = folder, setup, history, 0
+        self.folder, self.setup, self.history, self.count = folder, setup, history, int(count)
+        for k in range(1, self.count + 1):
+            folder.picture(f"patch_{k}")
 
     def __call__(self, solver: Any) -> None:
         """Nothing after a step."""

@@ -6,6 +6,7 @@ import logging
 import time
 import warnings
 from collections.abc import Callable
+from dataclasses import fields
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -218,16 +219,17 @@ def run(config: PressureVesselConfig, out: str | None = None,
     """Run the vessel of ``config`` (see :mod:`arlequin.demos.pressure_vessel`); ``restore``
     (a checkpoint of ``out``, :func:`resume`) continues an interrupted run."""
     start = time.perf_counter()
-    setup = build(config)
+    setup, bore_area = _start(config, restore)
     folder = (
         ResultsFolder(out, "arlequin pressure-vessel", config.inputs(), config.units())
         if out
         else None
     )
-    recorder = _Recorder(config, setup, _bore_area(setup, config.inner))
+    recorder = _Recorder(config, setup, bore_area)
     if restore is not None:
         recorder.history = restore["history"]
         recorder.max_coarse_yield_ratio = restore["max_coarse_yield_ratio"]
+        recorder.elastic, recorder.yielded = restore.get("elastic"), restore.get("yielded", False)
         first_yield = restore["first_yield_pressure"]
     elif setup.adapt is None:
         first_yield = _first_yield(config, setup)
@@ -249,9 +251,7 @@ def run(config: PressureVesselConfig, out: str | None = None,
     except KeyboardInterrupt:  # every converged step is on disk, with its checkpoint
         if folder is not None:
             folder.add_results(_so_far(recorder, setup))
-            folder.finish("interrupted", "interrupted: every converged step is kept; an adaptive "
-                          "run has no checkpoint, run it again" if setup.adapt is not None
-                          else f"interrupted: continue with --resume --out {out}")  # fmt: skip
+            folder.finish("interrupted", f"interrupted: continue with --resume --out {out}")
         raise
     if first_yield is None:
         first_yield = recorder.first_yield_pressure()
@@ -269,6 +269,28 @@ def run(config: PressureVesselConfig, out: str | None = None,
     return result
 
 
+def _start(config: PressureVesselConfig,
+           restore: dict[str, Any] | None) -> tuple[VesselSetup, float]:  # fmt: skip
+    """The set-up of a run and its bore's area (on the seed patch, as the uninterrupted run's);
+    a resumed adaptive run's set-up follows the grown patch of its checkpoint."""
+    setup = build(config)
+    bore_area = _bore_area(setup, config.inner)
+    if restore is None:
+        return setup, bore_area
+    if restore.get("config", config) != config:
+        names = [f.name for f in fields(config) if getattr(config, f.name)
+                 != getattr(restore["config"], f.name, None)]  # fmt: skip
+        raise ValueError(f"the checkpoint is of another configuration (it differs in {names})")
+    if (restore.get("adapt") is None) != (setup.adapt is None):
+        other = "without" if setup.adapt is not None else "with"
+        raise ValueError(f"the checkpoint is of a run {other} an adaptive patch, not of this "
+                         f"configuration (adaptive={config.adaptive})")  # fmt: skip
+    if setup.adapt is not None:  # the grown problem, the growths so far
+        setup.adapt.resume(setup.problem, restore["adapt"])
+        setup.follow(setup.adapt)
+    return setup, bore_area
+
+
 def _so_far(recorder: _Recorder, setup: VesselSetup) -> dict[str, Any]:
     """The results of the converged steps so far (a stopped run's results.json): the history,
     and the growths of an adaptive patch."""
@@ -280,8 +302,8 @@ def _so_far(recorder: _Recorder, setup: VesselSetup) -> dict[str, Any]:
 
 def _listeners(config, setup, folder, recorder, first_yield, progress, restore) -> list:
     """What each converged step calls: the recorder, the results folder's writer (the frames
-    and rows of a resumed run first written again), the checkpoint (fixed patches: a growing
-    patch's problem is not in it), the adaptation pictures, the progress."""
+    and rows of a resumed run first written again), the adaptation pictures and results.json
+    (an adaptive run), the checkpoint, the progress."""
     listeners: list[Callable[[Any], Any]] = [recorder]
     if folder is not None:
         from .report import AdaptationPictures, cell_fields
@@ -294,22 +316,26 @@ def _listeners(config, setup, folder, recorder, first_yield, progress, restore) 
                                       replay=replay, measures=recorder.last,
                                       measure_units=MEASURE_UNITS)  # fmt: skip
         listeners.append(writer)
-        if setup.adapt is not None:
-            listeners.append(AdaptationPictures(folder, setup, recorder.history))
-            # no checkpoint (the grown problem is not in it): results.json after every step,
-            # so that a hard stop keeps the history of every converged step on disk
+        adapt = setup.adapt
+        if adapt is not None:
+            # the pictures of the growths so far (a resumed run's) are on disk already
+            listeners.append(AdaptationPictures(folder, setup, recorder.history,
+                                                count=len(adapt.records)))  # fmt: skip
+            # results.json after every step: a hard stop keeps every converged step's history
             listeners.append(lambda solver: folder.add_results(_so_far(recorder, setup)))
-        else:
-            path = folder.path / CHECKPOINT
+        path = folder.path / CHECKPOINT
 
-            def checkpoint(solver: Any) -> None:
-                write_checkpoint(path, {
-                    "config": config, "solver": solver.checkpoint(), "history": recorder.history,
-                    "max_coarse_yield_ratio": recorder.max_coarse_yield_ratio,
-                    "first_yield_pressure": first_yield,
-                })  # fmt: skip
+        def checkpoint(solver: Any) -> None:
+            # an adaptive run's: its patch's (the grown problem is rebuilt from its cells)
+            write_checkpoint(path, {
+                "config": config, "solver": solver.checkpoint(), "history": recorder.history,
+                "max_coarse_yield_ratio": recorder.max_coarse_yield_ratio,
+                "first_yield_pressure": first_yield, "elastic": recorder.elastic,
+                "yielded": recorder.yielded,
+                "adapt": None if adapt is None else adapt.checkpoint(),
+            })  # fmt: skip
 
-            listeners.append(checkpoint)
+        listeners.append(checkpoint)
     if progress is not None:
         listeners.append(lambda solver: progress(solver.t))
     return listeners
@@ -360,12 +386,22 @@ def _result(config, setup, qs, recorder, first_yield, wall) -> PressureVesselRes
 def resume(out: str, progress: Callable[[float], None] | None = None) -> PressureVesselResult:
     """Continue the interrupted run whose results folder is ``out`` from its last converged
     step (its checkpoint), with the inputs it was started with; the same steps and values as
-    the uninterrupted run. Runs with a growing patch write no checkpoint."""
+    the uninterrupted run (an adaptive run's from its grown patch, its growths so far and the
+    field series they opened).
+
+    Raises
+    ------
+    CheckpointError
+        A ValueError: no checkpoint in ``out``, or an unreadable one.
+    """
     snap = read_checkpoint(Path(out) / CHECKPOINT)
     # the rows and frames of the checkpoint's steps (not those written after it, if any)
     solver = snap["solver"]
     snap["replay"] = QuasiStaticRunWriter.written(out, steps=len(solver["history"]),
                                                   load_factor=solver["t"])  # fmt: skip
+    # an adaptive run's series: one a growth (fields/patch0_K.xdmf), K up to the checkpoint's
+    adapt = snap.get("adapt")
+    snap["replay"]["growths"] = 0 if adapt is None else len(adapt["records"])
     return run(snap["config"], out=out, progress=progress, restore=snap)
 
 
