@@ -123,10 +123,12 @@ def test_auto_mediator_resolution():
         arlequin.Patch(_j2(mesh), gluing_width=6e-3, mediator="both")
 
 
-def test_nested_3d_patch_defaults_show_the_materials_plastic_strain(coarse3d, mono3d):
-    """Nested patch to 4R, defaults: the largest plastic strain within 10% of the single fine
-    mesh's (measured −1.1%) at the same point, not in the band, the band elastic."""
-    patch = _nested(coarse3d, 4.0)
+@pytest.mark.parametrize("coupling", ["H1", "L2"])
+def test_nested_3d_patch_defaults_show_the_materials_plastic_strain(coarse3d, mono3d, coupling):
+    """Nested patch to 4R, defaults (H1, the default coupling, and L2): the largest plastic
+    strain within 10% of the single fine mesh's (measured −1.1% with both) at the same point,
+    not in the band, the band elastic."""
+    patch = _nested(coarse3d, 4.0, coupling=coupling)
     (peak, where), result, band_warnings, pc, state = _arlequin(coarse3d, patch)
     assert pc.mediator == "fine"  # 41 unheld band cells: "auto" takes the fine mediator
     assert unheld_band_cells(pc).size > 0
@@ -277,3 +279,53 @@ def test_vessel_demo_reports_its_peak_and_band(pressure, band_yields):
         bore = np.linalg.norm(arl.max_plastic_strain_position)
         assert bore == pytest.approx(np.linalg.norm(mono.max_plastic_strain_position), rel=1e-3)
         assert arl.max_plastic_strain_in_band is False
+
+
+def test_2d_notch_defaults():
+    """A plate with a slot (plane strain quadrilaterals; the symmetry half, the slot 5 mm wide
+    and 20 mm deep from the top edge) pulled to 60 MPa: a nested patch over the slot's root,
+    defaults (the coarse mediator: every quadrilateral of the band keeps a vertex of positive
+    weight). The largest plastic strain, at the root's corner, within 10% of the single fine
+    mesh's at the same point (measured 0.0020174 against 0.0020239, −0.3%), the band elastic."""
+    import skfem
+
+    w, h = 0.1, 0.05
+
+    def slotted(size):
+        mesh = skfem.MeshQuad.init_tensor(np.linspace(0, w, round(w / size) + 1),
+                                          np.linspace(0, h, round(h / size) + 1))  # fmt: skip
+        c = mesh.p[:, mesh.t].mean(axis=1)
+        return mesh.restrict(np.nonzero(~((c[0] < 0.005) & (c[1] > 0.03)))[0])
+
+    def supports(problem, blocks):
+        for block in blocks:
+            problem.add_dirichlet(block, lambda x: np.isclose(x[0], 0.0), components=[0])
+        problem.add_dirichlet(blocks[0], lambda x: np.isclose(x[1], 0.0) & np.isclose(x[0], w),
+                              components=[1])  # fmt: skip
+        problem.add_traction(np.array([60e6, 0.0]), where=lambda x: np.isclose(x[0], w))
+
+    def peak(model, state):
+        eqps = model.equivalent_plastic_strain(state)
+        cell, point = np.unravel_index(np.argmax(eqps), eqps.shape)
+        return eqps.max(), np.asarray(model.quadrature_points())[:, cell, point]
+
+    coarse = slotted(2.5e-3)
+    mono = _j2(coarse.refined(1))
+    single = arlequin.ArlequinProblem(mono, [])
+    supports(single, ["coarse"])
+    reference = peak(
+        mono, arlequin.solve_quasi_static(single, load=1.0, steps=6).states["coarse"][0]
+    )
+    patch = arlequin.Patch.from_box(coarse, ((0.0, 0.015), (0.025, 0.05)), _j2, levels=1,
+                                    gluing_width=5e-3)  # fmt: skip
+    problem = arlequin.ArlequinProblem(LinearElastic(coarse, STEEL.elastic, "plane_strain"),
+                                       [patch])  # fmt: skip
+    supports(problem, ["coarse", "patch0"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", arlequin.ExactnessWarning)  # the band's corners
+        result = arlequin.solve_quasi_static(problem, load=1.0, steps=6)
+    value, where = peak(patch.model, result.states["patch0"][0])
+    assert problem.couplings[0].mediator == "coarse"
+    assert value == pytest.approx(reference[0], rel=0.10)
+    np.testing.assert_allclose(where, reference[1], atol=1e-12)
+    assert result.band_plastic_fraction == 0.0

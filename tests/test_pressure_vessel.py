@@ -326,3 +326,19 @@ def test_3d_adaptive_run_draws_its_growths(tmp_path):
     assert (out / "patch_1.png").exists()
     meta = json.loads((out / "results.json").read_text())
     assert meta["status"] == "failed" and "max_fraction" in meta["message"]
+
+
+@pytest.mark.parametrize("ratio", [2, 3, 5])
+def test_adaptive_first_yield_from_the_run_itself(ratio):
+    """Issue 42, part 2: the adaptive sphere's first yield read from its own last elastic
+    state (on the patch grown by then), not from a probe patch: within 0.5% of Hill at
+    b/a = 2, 3 and 5 (measured +0.29%, +0.33%, +0.26%; the probe on two rings gave +0.40%,
+    +0.89%, +1.88%, the seed +1.7%, +3.1%, +5.0%). To 1.25 P0 in 5 steps: the first yield
+    falls between the third and fourth."""
+    b = A * ratio
+    p0 = hill.sphere_first_yield(A, b, SY)
+    r = run_pressure_vessel(model="arlequin", outer=b, adaptive=True, pressure=1.25 * p0,
+                            steps=5)  # fmt: skip
+    assert r.first_yield_pressure == pytest.approx(p0, rel=0.005)
+    assert r.adaptations  # the patch grew before the first yield
+    assert r.band_plastic_fraction == 0.0

@@ -22,7 +22,10 @@ __all__ = ["FieldSeries", "meshio_mesh", "pad_vectors", "read_series"]
 
 
 def meshio_mesh(mesh: Any) -> meshio.Mesh:
-    """The meshio mesh of a scikit-fem mesh (its node order; points padded to ≥ 2 columns)."""
+    """The meshio mesh of a scikit-fem mesh (its node order; points padded to ≥ 2 columns); a
+    meshio mesh as it is (one read back, :func:`read_series`)."""
+    if isinstance(mesh, meshio.Mesh):
+        return mesh
     out = to_meshio(mesh)
     if out.points.shape[1] == 1:
         out.points = np.hstack([out.points, np.zeros((out.points.shape[0], 2))])
@@ -60,7 +63,7 @@ class FieldSeries:
     ----------
     path : str or Path
         The ``.xdmf`` file to write (the ``.h5`` file goes beside it).
-    mesh : skfem.Mesh
+    mesh : skfem.Mesh or meshio.Mesh
         The (reference) mesh.
 
     Examples

@@ -137,6 +137,13 @@ class DynamicRunWriter:
         self._growths = getattr(self, "_growths", 0) + 1
         for bf in self.layout.blocks:
             if bf.mesh is not self._meshes.get(bf.name):
+                current = self.series.get(bf.name)
+                if current is not None and not current.times:
+                    # the outgoing mesh's series has no frame (a growth before the run's first
+                    # frame): removed, no field listed without data
+                    self._folder.remove_series(current)
+                    del self.series[bf.name]
+                    self._grown.discard(bf.name)
                 # opened at the next frame: growths between two frames leave no empty series
                 self._pending_series[bf.name] = (f"{self._prefix}{bf.name}_{self._growths}",
                                                  bf.mesh)  # fmt: skip
@@ -208,7 +215,10 @@ class QuasiStaticRunWriter:
     units : mapping, optional
         Units of those fields (recorded in results.json).
     replay : dict, optional
-        What an interrupted run had written (:meth:`written`), written again first.
+        What an interrupted run had written (:meth:`written`), written again first; with
+        ``replay["growths"] = K`` (an adaptive run's growths at its checkpoint) the series
+        its growths opened too, ``NAME_1`` to ``NAME_K`` on their own meshes, the next frames
+        going to the last (``layout`` is then the grown problem's).
     measures : callable, optional
         ``measures(solver) -> {name: value}``: the demo's own columns of ``history.csv``.
     measure_units : mapping, optional
@@ -225,7 +235,11 @@ class QuasiStaticRunWriter:
         step_units = {**STEP_COLUMNS, **(measure_units or {}), **STEP_NEWTON_COLUMNS}
         self.history = folder.history(list(step_units), step_units)
         self.newton = folder.history(list(NEWTON_COLUMNS), NEWTON_COLUMNS, name="newton")
-        self.series = {bf.name: folder.series(bf.name, bf.mesh) for bf in layout.blocks}
+        self._growths = 0 if replay is None else int(replay.get("growths", 0))
+        # a resumed adaptive run: the first series on the meshes they were written on
+        first = replay["meshes"] if self._growths else {}
+        self.series = {bf.name: folder.series(bf.name, first.get(bf.name, bf.mesh))
+                       for bf in layout.blocks}  # fmt: skip
         self._meshes = {bf.name: bf.mesh for bf in layout.blocks}
         folder.meta.setdefault("field_units", {}).update({**layout.units, **(units or {})})
         if replay is not None:
@@ -234,16 +248,27 @@ class QuasiStaticRunWriter:
     def _replay(self, replay: dict[str, Any]) -> None:
         """A resumed run: what the interrupted one had written, first (its rows as their
         text, so that the files equal those of an uninterrupted run; a file of another
-        layout is not written again)."""
+        layout is not written again), and its frames: in the series of its growths up to
+        the checkpoint's, opened again in their order (those of later growths, made again,
+        are not)."""
         for writer, name in ((self.history, "history"), (self.newton, "newton")):
             header, rows = replay["rows"].get(name, (None, []))
             if header == writer.header:
                 for row in rows:
                     writer.append_text(row)
+        series = dict(self.series)  # by file name
+        for k in range(1, self._growths + 1):
+            for bf in self.layout.blocks:
+                name = f"{bf.name}_{k}"
+                if name in replay["meshes"]:
+                    series[name] = self._folder.series(name, replay["meshes"][name])
+                    self.series[bf.name] = series[name]
         for name, frames in replay["frames"].items():
+            if name not in series:  # a later growth's (made again) or another run's
+                continue
             for t, point, cell in frames:  # meshio gives cell data per cell block
                 cell = {k: v[0] if isinstance(v, list) else v for k, v in cell.items()}
-                self.series[name].write(t, point, cell)
+                series[name].write(t, point, cell)
 
     @staticmethod
     def written(out: str | os.PathLike, steps: int | None = None,
@@ -252,7 +277,7 @@ class QuasiStaticRunWriter:
         frames (read before a resumed run's writer opens the files again), those of the first
         ``steps`` converged steps only (the rows) and of the load factors up to
         ``load_factor`` (the frames): the ones of its checkpoint, whatever was written after
-        it before the run stopped."""
+        it before the run stopped), and each series' mesh (``meshes``, meshio's)."""
         out = Path(out)
         rows: dict[str, tuple[list[str], list[list[str]]]] = {}
         for name in ("history", "newton"):
@@ -262,18 +287,19 @@ class QuasiStaticRunWriter:
                 if steps is not None and header and header[0] == "step [1]":
                     lines = [r for r in lines if r and int(float(r[0])) <= steps]
                 rows[name] = (header, lines)
-        frames = {p.stem: read_series(p)[1] for p in sorted((out / "fields").glob("*.xdmf"))}
+        read = {p.stem: read_series(p) for p in sorted((out / "fields").glob("*.xdmf"))}
+        frames = {k: v[1] for k, v in read.items()}
         if load_factor is not None:
             limit = load_factor + 1e-12 * max(abs(load_factor), 1.0)
             frames = {k: [f for f in v if f[0] <= limit] for k, v in frames.items()}
-        return {"rows": rows, "frames": frames}
+        return {"rows": rows, "frames": frames, "meshes": {k: v[0] for k, v in read.items()}}
 
     def on_adapt(self, solver: Any, adapt: Any) -> None:
         """A patch grew (``solve_quasi_static(..., adapt=)``): the next frames go on the new
         system, the blocks whose mesh changed into a new series ``fields/NAME_K.xdmf`` (K the
         growths so far: a meshio XDMF time series holds one mesh)."""
         self.system, self.layout = solver.system, adapt.problem.field_layout()
-        self._growths = getattr(self, "_growths", 0) + 1
+        self._growths += 1
         for bf in self.layout.blocks:
             if bf.mesh is not self._meshes[bf.name]:
                 self.series[bf.name] = self._folder.series(f"{bf.name}_{self._growths}", bf.mesh)

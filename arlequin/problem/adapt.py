@@ -32,7 +32,6 @@ from __future__ import annotations
 
 import logging
 import math
-import numbers
 import time
 import warnings
 from collections.abc import Callable
@@ -49,6 +48,7 @@ from ..coupling.fields import evaluate_field
 from ..coupling.patches import refine_region
 from ..geometry.locate import cell_centroids
 from ..geometry.reference import scalar_element_for
+from .adaptation import Adaptation, check_bounds, check_settings
 from .arlequin_problem import ArlequinProblem, von_mises_of
 
 __all__ = [
@@ -76,82 +76,6 @@ class IndicatorError(ValueError):
 class PatchLimitError(SimulationError):
     """The patch would exceed ``max_fraction`` of the coarse mesh: the run stops (``result``
     holds every converged step, ``step`` and ``time`` the step that asked for the growth)."""
-
-
-@dataclass
-class Adaptation:
-    """One growth of the patch.
-
-    Attributes
-    ----------
-    step : int
-        The load step after which it grew (1 for the first).
-    time : float
-        The load factor of the fields it started from (the committed one).
-    n_fine_elements, n_coarse_cells : int
-        Cells of the new patch (fine) and coarse cells it covers.
-    patch_fraction : float
-        The new patch's share of the coarse mesh's area (plane measure).
-    rejected : bool
-        The step was not accepted (the coarse model yielded outside the patch) and was
-        computed again after the growth.
-    energy_jump : float or None
-        (E_after − E_before) / |E_before| of the total stored energy across the growth (set
-        by the solver after the multipliers are re-solved).
-    newton_iterations : int
-        Iterations of that re-solve.
-    energy_change : float or None
-        E_after − E_before (J) (explicit runs: the listeners' energy balances move by it).
-    wall_time_s : float
-        Time spent rebuilding the patch (its mesh, model, overlap, weights, gluing band,
-        coupling rows) and transferring the fields (s).
-    system_time_s : float
-        Time the solver spent on the new system's operators and saddle-point solver (s;
-        explicit runs: the new integrator, its stable step and impulse factorisation, and the
-        rebuilt constraints).
-    resolve_time_s : float
-        Time of the re-solve of the multipliers and fields at the same load (s; explicit
-        runs: the new integrator's first impulse and the energies across the growth).
-    discarded_time_s : float
-        Time of the rejected step (explicit runs: interval) computed again after the growth
-        (s; 0 if accepted).
-    """
-
-    step: int
-    time: float
-    n_fine_elements: int
-    n_coarse_cells: int
-    patch_fraction: float
-    rejected: bool
-    energy_jump: float | None = None
-    newton_iterations: int = 0
-    wall_time_s: float = 0.0
-    system_time_s: float = 0.0
-    resolve_time_s: float = 0.0
-    discarded_time_s: float = 0.0
-    energy_change: float | None = None
-
-    @property
-    def adapt_time_s(self) -> float:
-        """The growth's whole cost (s): rebuild, transfer, new operators, re-solve and the
-        rejected step's time."""
-        return self.wall_time_s + self.system_time_s + self.resolve_time_s + self.discarded_time_s
-
-    def to_json(self) -> dict[str, Any]:
-        """The adaptation as plain JSON (an entry of the demos' ``adaptations``)."""
-        return {
-            "step": self.step,
-            "time": self.time,
-            "n_fine_elements": self.n_fine_elements,
-            "patch_fraction": self.patch_fraction,
-            "energy_jump": self.energy_jump,
-            "rejected": self.rejected,
-            "newton_iterations": self.newton_iterations,
-            "rebuild_time_s": self.wall_time_s,
-            "system_time_s": self.system_time_s,
-            "resolve_time_s": self.resolve_time_s,
-            "discarded_time_s": self.discarded_time_s,
-        }
 
 
 @dataclass(frozen=True)
@@ -196,11 +120,6 @@ class Growth:
     reject: bool
 
 
-def _is_real(value: Any) -> bool:
-    """A real number (numpy scalars included), not a bool."""
-    return isinstance(value, numbers.Real) and not isinstance(value, bool)
-
-
 def cell_rings(mesh: Any, mask: np.ndarray, rings: int) -> np.ndarray:
     """``mask`` of cells grown by ``rings`` layers of cells sharing a node with it."""
     out = mask.copy()
@@ -222,35 +141,6 @@ def _match(old: np.ndarray, new: np.ndarray, tol: float) -> tuple[np.ndarray, np
     dist, idx = cKDTree(old.T).query(new.T, distance_upper_bound=tol)
     hit = np.isfinite(dist)
     return np.nonzero(hit)[0], idx[hit]
-
-
-def _check_settings(
-    threshold: Any, buffer: Any, band_cells: Any, every: Any, patch: Any, interval: Any
-) -> None:
-    """:class:`AdaptivePatch`'s threshold, counts and check interval, each named if wrong."""
-    if not (_is_real(threshold) and 0.0 < threshold <= 1.0):
-        raise ValueError(f"threshold β must lie in (0, 1], got threshold={threshold!r}")
-    for name, value, low in (("buffer", buffer, 0), ("band_cells", band_cells, 0),
-                             ("every", every, 1), ("patch", patch, 0)):  # fmt: skip
-        if isinstance(value, bool) or int(value) != value or value < low:
-            raise ValueError(f"{name} must be an integer >= {low}, got {name}={value!r}")
-    if interval is not None and not (
-        _is_real(interval) and math.isfinite(interval) and interval > 0.0
-    ):
-        raise ValueError(f"interval must be a positive time (s), got interval={interval!r}")
-
-
-def _check_bounds(max_fraction: Any, band_weight: Any, levels: Any, indicator: Any) -> None:
-    """:class:`AdaptivePatch`'s fraction, band weight, levels and indicator, each named if
-    wrong."""
-    if not (_is_real(max_fraction) and 0.0 < max_fraction <= 1.0):
-        raise ValueError(f"max_fraction must lie in (0, 1], got max_fraction={max_fraction!r}")
-    if not (_is_real(band_weight) and 0.0 <= band_weight < 1.0):
-        raise ValueError(f"band_weight must lie in [0, 1), got band_weight={band_weight!r}")
-    if levels is not None and (int(levels) != levels or levels < 0):
-        raise ValueError(f"levels must be a non-negative integer, got levels={levels}")
-    if indicator is not None and not callable(indicator):
-        raise ValueError(f"indicator must be callable, got {type(indicator).__name__}")
 
 
 class AdaptivePatch:
@@ -321,9 +211,9 @@ class AdaptivePatch:
         interval: float | None = None,
         band_weight: float = 0.0,
     ) -> None:
-        _check_settings(threshold, buffer, band_cells, every, patch, interval)
+        check_settings(threshold, buffer, band_cells, every, patch, interval)
         self.interval = None if interval is None else float(interval)
-        _check_bounds(max_fraction, band_weight, levels, indicator)
+        check_bounds(max_fraction, band_weight, levels, indicator)
         self.model_factory, self.levels, self.refine = model_factory, levels, refine
         self.threshold, self.buffer, self.band_cells = float(threshold), int(buffer), band_cells
         self.every, self.max_fraction, self.indicator = int(every), float(max_fraction), indicator
@@ -334,6 +224,10 @@ class AdaptivePatch:
         self.records: list[Adaptation] = []
         self.max_coarse_yield_ratio = 0.0
         self.problem: ArlequinProblem | None = None
+        #: the growth decided after the last accepted step and not made yet (the solver makes
+        #: it after the step's listeners: a checkpoint one of them writes holds it)
+        self.pending: Growth | None = None
+        self._resumed: ArlequinProblem | None = None  # the problem of :meth:`resume`
 
     # -- set-up ------------------------------------------------------------------------------
     @property
@@ -358,10 +252,11 @@ class AdaptivePatch:
         coarse = problem.coarse
         if not coarse.is_linear or not callable(getattr(coarse, "stress_at_quadrature", None)):
             raise ValueError("adaptation needs a linear coarse model with stress_at_quadrature(u)")
-        self.problem = problem
-        # a new run: the growths and the coarse yield ratio of an earlier run with this object
-        # are not this one's (a new list: the earlier result keeps its own)
-        self.records, self.max_coarse_yield_ratio = [], 0.0
+        self.problem, resumed, self._resumed = problem, problem is self._resumed, None
+        if not resumed:
+            # a new run: the growths and the coarse yield ratio of an earlier run with this
+            # object are not this one's (a new list: the earlier result keeps its own)
+            self.records, self.max_coarse_yield_ratio, self.pending = [], 0.0, None
         pc = problem.couplings[self.index]
         if pc.overlap.method != "nested":
             raise NonNestedPatchError(
@@ -406,6 +301,73 @@ class AdaptivePatch:
                 f"give its mesh ({again.nelements} cells, {hit.size} matching of "
                 f"{mesh.nelements}): the patch is not nested, or give the refine= that built it"
             )
+
+    # -- checkpoints -------------------------------------------------------------------------
+    def checkpoint(self) -> dict[str, Any]:
+        """What a run needs to continue with this patch (picklable; :meth:`resume`).
+
+        Returns
+        -------
+        dict
+            ``cells`` (the patch's coarse cells), ``records`` (the growths so far, copies),
+            ``max_coarse_yield_ratio``, ``pending`` (the coarse cells of the growth decided
+            after the last accepted step and not made yet, or None), and what
+            :meth:`resume` checks the problem by: ``n_coarse_cells`` and ``patch``.
+        """
+        return {
+            "cells": np.array(self.cells, dtype=np.int64),
+            "records": [replace(r) for r in self.records],
+            "max_coarse_yield_ratio": float(self.max_coarse_yield_ratio),
+            "pending": None if self.pending is None else np.array(self.pending.cells),
+            "n_coarse_cells": int(self.problem.coarse.mesh.nelements),
+            "patch": self.index,
+        }
+
+    def resume(self, problem: Any, snapshot: dict[str, Any]) -> ArlequinProblem:
+        """The grown problem of a :meth:`checkpoint`, rebuilt from the problem the run
+        started on (``problem``, with its seed patch) as :meth:`grow` built it, and this
+        object back at the checkpoint (its growths, coarse yield ratio, pending growth).
+
+        Pass the grown problem on with the solver's checkpoint,
+        ``solve_quasi_static(grown, adapt=self, restore=solver_checkpoint)``: :meth:`bind`
+        keeps the growths of a resumed run, and the solver first makes a pending growth
+        (decided after the checkpoint's step, not made before the run stopped), so that the
+        run goes on as the uninterrupted one.
+
+        Raises
+        ------
+        ValueError
+            ``snapshot`` is not a :meth:`checkpoint`, or one of another problem (another
+            coarse mesh or patch, or cells that do not contain the seed's).
+        """
+        keys = ("cells", "records", "max_coarse_yield_ratio", "pending", "n_coarse_cells",
+                "patch")  # fmt: skip
+        missing = [k for k in keys if k not in snapshot] if isinstance(snapshot, dict) else keys
+        if missing:
+            raise ValueError(f"resume: the snapshot is not an AdaptivePatch.checkpoint() "
+                             f"(it lacks {list(missing)})")  # fmt: skip
+        self.bind(problem)
+        n, cells = problem.coarse.mesh.nelements, np.asarray(snapshot["cells"], dtype=np.int64)
+        if (
+            snapshot["n_coarse_cells"] != n
+            or snapshot["patch"] != self.index
+            or not np.isin(self.cells, cells).all()
+            or cells.max() >= n
+            or cells.min() < 0
+        ):
+            raise ValueError(
+                f"resume: the snapshot is of another problem (patch {snapshot['patch']} on "
+                f"{cells.size} of {snapshot['n_coarse_cells']} coarse cells; this one: patch "
+                f"{self.index} on {self.cells.size} of {n}, which the snapshot's must contain)"
+            )  # fmt: skip
+        if not np.array_equal(cells, self.cells):  # grown (the seed itself otherwise)
+            self.problem, self.cells = self._problem_on(problem, cells), cells
+        self.records = [replace(r) for r in snapshot["records"]]
+        self.max_coarse_yield_ratio = float(snapshot["max_coarse_yield_ratio"])
+        pending = snapshot["pending"]
+        self.pending = None if pending is None else Growth(np.asarray(pending, np.int64), False)
+        self._resumed = self.problem
+        return self.problem
 
     # -- the indicator -----------------------------------------------------------------------
     def view(self, solver: Any, step: int) -> AdaptView:
@@ -523,25 +485,33 @@ class AdaptivePatch:
             )
         old = self.problem
         old_pc = old.couplings[self.index]
-        model = self.model_factory(self.refine(cells))
-        patches = list(old.patches)
-        patches[self.index] = replace(patches[self.index], model=model)
-        new = old.with_patches(patches)
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always", ExactnessWarning)
-            new.couplings  # noqa: B018
-        for w in caught:
-            logger.info("%s", w.message)
+        new = self._problem_on(old, cells)
+        model = new.patches[self.index].model
         self._last = (old, new)
         u_new = self._transfer_u(old, new, u)
         state = self._transfer_state(old_pc, new.couplings[self.index], states[self.name][0])
-        self.problem, self.cells = new, cells
+        self.problem, self.cells, self.pending = new, cells, None
         rec = Adaptation(step, float(time_), int(model.mesh.nelements), int(cells.size), fraction,
                          bool(growth.reject), wall_time_s=time.perf_counter() - start)  # fmt: skip
         self.records.append(rec)
         logger.info("step %d: %s grew to %d coarse cells (%d fine, %.3f of the mesh)", step,
                     self.name, cells.size, model.mesh.nelements, fraction)  # fmt: skip
         return new, u_new, {self.name: [state]}
+
+    def _problem_on(self, base: ArlequinProblem, cells: np.ndarray) -> ArlequinProblem:
+        """``base`` with the adapted patch on the coarse ``cells``: its mesh ``refine(cells)``,
+        its model ``model_factory(mesh)``, the couplings built (their exactness warnings
+        logged)."""
+        model = self.model_factory(self.refine(cells))
+        patches = list(base.patches)
+        patches[self.index] = replace(patches[self.index], model=model)
+        new = base.with_patches(patches)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", ExactnessWarning)
+            new.couplings  # noqa: B018
+        for w in caught:
+            logger.info("%s", w.message)
+        return new
 
     def transfer_displacement(self, u: np.ndarray) -> np.ndarray:
         """A displacement of the problem before the last growth moved onto the grown one (as

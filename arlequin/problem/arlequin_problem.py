@@ -22,13 +22,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..contract import ContractError, Model, check_protocol
-from ..coupling.band_plasticity import (
-    BandPlasticity,
-    PlasticPeak,
-    band_cells,
-    band_plasticity,
-    plastic_peak,
-)
+from ..coupling.band_plasticity import BandPlasticity, band_plasticity
 from ..coupling.gluing import Patch, PatchCoupling
 from ..coupling.overlap import OverlapError
 from ..dofs import DofMap
@@ -439,15 +433,6 @@ class ArlequinProblem:
         patch whose model tells its plastic strain."""
         bands = (band_plasticity(pc, (states.get(pc.name) or [None])[0]) for pc in self.couplings)
         return [band for band in bands if band is not None]
-
-    def plastic_peak(self, block: str, state: Any) -> PlasticPeak | None:
-        """The largest equivalent plastic strain of block ``block``'s model in ``state`` (its
-        first term's), where it lies and whether in its gluing band (a patch) — None for a
-        model without plastic strain (:func:`arlequin.coupling.band_plasticity.plastic_peak`)."""
-        pc = next((pc for pc in self.couplings if pc.name == block), None)
-        if pc is not None:
-            return plastic_peak(pc.fine_model, state, band_cells(pc))
-        return plastic_peak(self.model(block), state)
 
     def mediator_rows(self, pc: PatchCoupling) -> np.ndarray:
         """Boolean mask of the mediator functions of ``pc`` kept as coupling rows (all of them,

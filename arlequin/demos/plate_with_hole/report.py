@@ -11,6 +11,7 @@ import numpy as np
 from ...io import ResultsFolder
 from ...problem.arlequin_problem import von_mises_of
 from ..adaptive_options import growth_title
+from ..plastic_report import mark_peak
 from .result import PlateWithHoleResult
 from .setup import PlateSetup
 
@@ -77,7 +78,8 @@ def plot_load_curve(result: PlateWithHoleResult, path: str) -> None:
 
 
 def plot_plastic_zone(setup: PlateSetup, state: Any, path: str, radius: float,
-                      title: str = "plastic zone (white: points with ε̄p > 0)") -> None:  # fmt: skip
+                      title: str = "plastic zone (white: points with ε̄p > 0)",
+                      peak: dict[str, Any] | None = None) -> None:  # fmt: skip
     """ε̄p over the J2 model's cells (within 5 hole radii), the coarse mesh's edges beside."""
     import matplotlib
 
@@ -103,6 +105,8 @@ def plot_plastic_zone(setup: PlateSetup, state: Any, path: str, radius: float,
     ax.set_aspect("equal")
     fig.colorbar(coll, ax=ax, label="equivalent plastic strain")
     ax.set_title(title, fontsize=10)
+    if peak is not None:  # where the largest plastic strain lies, in the band or not
+        mark_peak(ax, peak)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
@@ -165,4 +169,10 @@ def write_pictures(folder: ResultsFolder, setup: PlateSetup, qs: Any,
     if setup.adapt is not None:
         plot_patch_size(result, str(folder.picture("patch_size")))
     state = qs.states[setup.plastic_block][setup.plastic_term]
-    plot_plastic_zone(setup, state, str(folder.picture("plastic_zone")), result.config["radius"])
+    plot_plastic_zone(
+        setup,
+        state,
+        str(folder.picture("plastic_zone")),
+        result.config["radius"],
+        peak=result.to_json(),
+    )

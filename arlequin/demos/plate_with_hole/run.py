@@ -234,7 +234,9 @@ def run(config: PlateWithHoleConfig, out: str | None = None,
         max_coarse_yield_ratio=_coarse_ratio(setup, recorder),
         plastic_cover_fraction=plastic_cover_fraction(setup, state.eqps, config.gluing_rings),
         band_fraction=band_fraction(setup),
-        **plastic_report(setup.problem, setup.plastic_block, state, recorder.band.fraction),
+        **plastic_report(
+            setup.problem, setup.plastic_block, setup.plastic_model, state, recorder.band.fraction
+        ),
     )
     if folder is not None:
         folder.add_results(result.to_json(), UNITS)

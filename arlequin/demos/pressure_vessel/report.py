@@ -13,6 +13,7 @@ from ...geometry.facets import cyclic_quad_faces
 from ...io import ResultsFolder
 from ...problem.arlequin_problem import von_mises_of
 from ..adaptive_options import growth_title
+from ..plastic_report import mark_peak
 from .hill import cylinder_limit_load, sphere_limit_load, sphere_outer_displacement
 from .measures import von_mises
 from .result import PressureVesselResult
@@ -120,7 +121,8 @@ def plane_polygons(mesh: Any) -> tuple[np.ndarray, np.ndarray]:
 
 
 def plot_plastic_zone(setup: VesselSetup, state: Any, path: str,
-                      title: str = "plastic zone over the coarse mesh") -> None:  # fmt: skip
+                      title: str = "plastic zone over the coarse mesh",
+                      peak: dict[str, Any] | None = None) -> None:  # fmt: skip
     """ε̄p over the J2 model's cells at the end of the run, the coarse mesh's edges beside
     (a 3D run: on its symmetry plane z = 0, :func:`plane_polygons`)."""
     import matplotlib
@@ -143,6 +145,8 @@ def plot_plastic_zone(setup: VesselSetup, state: Any, path: str,
     if setup.meshes.coarse.p.shape[0] == 3:
         title += " (plane z = 0)"
     ax.set_title(title, fontsize=10)
+    if peak is not None:  # where the largest plastic strain lies, in the band or not
+        mark_peak(ax, peak)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
@@ -153,19 +157,22 @@ def write_pictures(folder: ResultsFolder, setup: VesselSetup, qs: Any,
     """The run's pictures in its results folder."""
     plot_pressure_curve(result, result.config, str(folder.picture("pressure_displacement")))
     state = qs.states[setup.plastic_block][0]
-    plot_plastic_zone(setup, state, str(folder.picture("plastic_zone")))
+    plot_plastic_zone(setup, state, str(folder.picture("plastic_zone")), peak=result.to_json())
     if result.adaptations:
         plot_patch_size(result, str(folder.picture("patch_size")))
 
 
 class AdaptationPictures:
     """A listener of an adaptive run: the plastic zone over the grown patch, one picture a
-    growth (``patch_K.png``, from the fields the growth started from, re-solved)."""
+    growth (``patch_K.png``, from the fields the growth started from, re-solved); ``count``
+    the growths so far (a resumed run: their pictures, on disk, listed again)."""
 
     def __init__(self, folder: ResultsFolder, setup: VesselSetup,
-                 history: dict[str, list[Any]]) -> None:  # fmt: skip
+                 history: dict[str, list[Any]], count: int = 0) -> None:  # fmt: skip
         # history: the recorder's, whose last pressure is the committed state's (the growth's)
-        self.folder, self.setup, self.history, self.count = folder, setup, history, 0
+        self.folder, self.setup, self.history, self.count = folder, setup, history, int(count)
+        for k in range(1, self.count + 1):
+            folder.picture(f"patch_{k}")
 
     def __call__(self, solver: Any) -> None:
         """Nothing after a step."""

@@ -13,6 +13,11 @@ iterations of the re-solve, and the time of its parts
 (:class:`~arlequin.problem.adapt.Adaptation`: the rebuild and the transfer, the solver's new
 operators, the re-solve, the rejected step's); listeners with an ``on_adapt(solver, adapt)``
 member (the results writers) hear of it.
+
+A growth for the next step is made after the step's listeners: until then it is the
+adaptation's ``pending`` growth, so that a checkpoint written by a listener
+(``solver.checkpoint()`` and ``adapt.checkpoint()``) holds it, and a run resumed from it
+(``AdaptivePatch.resume``, ``restore=``) makes it first, as the uninterrupted run did.
 """
 
 from __future__ import annotations
@@ -136,9 +141,14 @@ def run_adaptive(
         converged step.
     """
     watch = BandYieldWatch(lambda: adapt.problem)
+    # a resumed run (AdaptivePatch.resume): the growth its checkpoint's step had decided
+    resumed = getattr(adapt, "pending", None)
     while solver.status == "running":
-        snap = solver.snapshot()
         try:
+            if resumed is not None:
+                _grow(solver, adapt, resumed, len(solver.history), on_step)
+                resumed = None
+            snap = solver.snapshot()
             start = time.perf_counter()
             rec = solver.step()
             if rec is None:  # a limit load
@@ -151,6 +161,9 @@ def run_adaptive(
                 _grow(solver, adapt, growth, step, on_step, discarded)
                 continue
             watch(solver)
+            # the growth for the next step, made after the listeners (a checkpoint one of them
+            # writes holds it: a resumed run makes it first)
+            adapt.pending = growth if growth is not None and solver.status == "running" else None
             for listener in on_step:
                 listener(solver)
             # a growth for the next step: none after the last (its state was accepted)

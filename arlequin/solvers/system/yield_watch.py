@@ -38,8 +38,6 @@ class BandYieldWatch:
     fraction : float or None
         Largest share of a band's quadrature weight that was plastic at a kept check (None
         before any check of a problem with a J2 patch).
-    worst : BandPlasticity or None
-        The band measure of that check (None while every band is elastic).
     """
 
     def __init__(self, problem_of: Callable[[], Any], when: str = "λ",
@@ -55,10 +53,6 @@ class BandYieldWatch:
         if not self.watched:
             return None
         return max((band.fraction for _, band in self.plastic), default=0.0)
-
-    @property
-    def worst(self) -> Any:
-        return max(self.plastic, key=lambda s: s[1].fraction)[1] if self.plastic else None
 
     def __call__(self, solver: Any) -> None:
         """Measure the bands at the solver's committed ``states`` (at its ``t``)."""
