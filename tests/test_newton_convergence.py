@@ -198,3 +198,44 @@ def test_a_resumed_run_writes_the_same_files(tmp_path, monkeypatch):
     run_module.resume(str(cut))
     for name in ("history.csv", "newton.csv"):
         assert (cut / name).read_bytes() == (full / name).read_bytes(), name
+
+
+def test_a_resumed_run_keeps_its_band_watch(tmp_path, monkeypatch):
+    """The gluing band's watch is in the checkpoint: a sphere whose patch ends at 0.15 m (its
+    band 0.125-0.15 m) yields in the band from the 8th step (240 MPa; Hill's front reaches
+    0.125 m at 228 MPa); interrupted after the 9th and resumed, it reports the whole run's
+    band share and does not warn again."""
+    import json
+    import warnings
+
+    import arlequin
+    import arlequin.solvers.statics.quasi_static as qs
+    from arlequin.demos.pressure_vessel import PressureVesselConfig
+    from arlequin.demos.pressure_vessel import run as run_module
+
+    config = PressureVesselConfig(steps=10, patch_outer=0.15, **COARSE)
+    full, cut = tmp_path / "full", tmp_path / "cut"
+    with pytest.warns(arlequin.BandYieldWarning, match="at λ = 0.8 patch0"):
+        run_module.run(config, out=str(full))
+
+    class Interrupted(Exception):
+        pass
+
+    original, calls = qs.QuasiStaticSolver.step, []
+
+    def step(self):
+        calls.append(1)
+        if len(calls) == 10:
+            raise Interrupted
+        return original(self)
+
+    monkeypatch.setattr(qs.QuasiStaticSolver, "step", step)
+    with pytest.raises(Interrupted), pytest.warns(arlequin.BandYieldWarning):
+        run_module.run(config, out=str(cut))
+    monkeypatch.setattr(qs.QuasiStaticSolver, "step", original)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", arlequin.BandYieldWarning)
+        run_module.resume(str(cut))
+    shares = [json.loads((d / "results.json").read_text())["results"]["band_plastic_fraction"]
+              for d in (full, cut)]  # fmt: skip
+    assert shares[0]["value"] > 0.0 and shares[1] == shares[0]

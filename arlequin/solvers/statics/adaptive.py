@@ -32,7 +32,6 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ...contract import SimulationError
-from ..system.yield_watch import BandYieldWatch
 
 __all__ = ["AdaptableSolver", "run_adaptive"]
 
@@ -109,7 +108,7 @@ def _grow(solver: Any, adapt: Any, growth: Any, step: int, listeners: Sequence[A
             hook(solver, adapt)
 
 
-def _finish(solver: Any, adapt: Any, watch: BandYieldWatch, message: str | None = None) -> Any:
+def _finish(solver: Any, adapt: Any, watch: Any, message: str | None = None) -> Any:
     result = watch.finish(solver.result(message))
     result.adaptations = list(adapt.records)
     result.max_coarse_yield_ratio = float(adapt.max_coarse_yield_ratio)
@@ -140,7 +139,7 @@ def run_adaptive(
         patch's cap (:class:`~arlequin.problem.adapt.PatchLimitError`); ``err.result`` holds every
         converged step.
     """
-    watch = BandYieldWatch(lambda: adapt.problem)
+    watch = solver.band_watch
     # a resumed run (AdaptivePatch.resume): the growth its checkpoint's step had decided
     resumed = getattr(adapt, "pending", None)
     while solver.status == "running":

@@ -28,10 +28,9 @@ only the nonlinear blocks and the multipliers. The factorisations use a sparse d
 (``linear_solver``: SuperLU, or PARDISO where pypardiso is installed, which keeps its symbolic
 analysis from one iteration of a load step to the next: :mod:`arlequin.linalg.direct`).
 
-Timings (failed attempts included): the models' internal forces, return maps and tangents, the
-factorisations, the solves, the rest, in :attr:`QuasiStaticSolver.timings` and the result's.
-After each converged step the coarse models' stress outside the patches and the patches'
-gluing bands are watched (``CoarseYieldWarning``, ``BandYieldWarning``). Units: SI.
+Timings (failed attempts included) in :attr:`QuasiStaticSolver.timings`. The coarse stress
+outside the patches and the gluing bands are watched (``CoarseYieldWarning``,
+``BandYieldWarning``). Units: SI.
 """
 
 from __future__ import annotations
@@ -48,7 +47,7 @@ from ...contract import StateError
 from ...linalg.direct import resolve_linear_solver
 from ..system.constraints import is_unilateral
 from ..system.operators import SystemOperators, as_system, as_vector
-from ..system.yield_watch import BandYieldWatch
+from ..system.yield_watch import UNWATCHED, BandYieldWatch
 from .adaptive import AdaptableSolver, run_adaptive
 from .condensation import SaddleSolver
 from .quasi_static_result import (
@@ -191,6 +190,7 @@ class QuasiStaticSolver(AdaptableSolver):
         self._first_stiffness: float | None = None
         self._last_stiffness: float | None = None
         self.status = "running"
+        self.band_watch = BandYieldWatch(lambda: self.system)  # the drivers call it
         if restore is not None:
             self._restore(restore)
 
@@ -419,7 +419,8 @@ class QuasiStaticSolver(AdaptableSolver):
         """The committed state of the run with its whole history (picklable: arrays and
         immutable states), from which ``QuasiStaticSolver(..., restore=checkpoint)`` continues
         bit for bit (:meth:`snapshot` is the lighter undo point of an adaptive run)."""
-        return {name: getattr(self, name) for name in self._CHECKPOINT}
+        return {**{name: getattr(self, name) for name in self._CHECKPOINT},
+                "band_watch": self.band_watch.state}  # fmt: skip
 
     def _restore(self, snap: dict[str, Any]) -> None:
         missing = [name for name in self._CHECKPOINT if name not in snap]
@@ -432,7 +433,7 @@ class QuasiStaticSolver(AdaptableSolver):
             )
         for name in self._CHECKPOINT:
             setattr(self, name, snap[name])
-        self.history = list(self.history)
+        self.history, self.band_watch.state = list(self.history), snap.get("band_watch", UNWATCHED)
 
     # -- adaptation (arlequin.problem.adapt, driven by arlequin.solvers.statics.adaptive) ---------
     def replace_system(self, system: Any, u: np.ndarray, states: dict[str, list[Any]]) -> None:
@@ -579,7 +580,7 @@ def solve_quasi_static(
     solver = QuasiStaticSolver(problem, load=load, steps=steps, **options)
     if adapt is not None:
         return run_adaptive(solver, adapt, on_step, callback)
-    watch, band = CoarseYieldWatch(problem), BandYieldWatch(lambda: problem)
+    watch, band = CoarseYieldWatch(problem), solver.band_watch
     message = None
     while solver.status == "running":
         try:

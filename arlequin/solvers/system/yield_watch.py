@@ -16,7 +16,10 @@ from typing import Any
 
 from ...contract import BandYieldWarning
 
-__all__ = ["BandYieldWatch"]
+__all__ = ["UNWATCHED", "BandYieldWatch"]
+
+#: The :attr:`BandYieldWatch.state` of a watch that has seen nothing (an older checkpoint's).
+UNWATCHED: tuple[bool, tuple, bool] = (False, (), False)
 
 
 class BandYieldWatch:
@@ -65,6 +68,16 @@ class BandYieldWatch:
                 self.plastic.append((float(solver.t), band))
         if not self.deferred:
             self._warn()
+
+    @property
+    def state(self) -> tuple[bool, list[tuple[float, Any]], bool]:
+        """What the watch has seen (picklable), for a run's checkpoint: a resumed run reports
+        the whole run's largest share and does not warn again."""
+        return self.watched, list(self.plastic), self.warned
+
+    @state.setter
+    def state(self, value: tuple[bool, list[tuple[float, Any]], bool]) -> None:
+        self.watched, self.plastic, self.warned = value[0], list(value[1]), value[2]
 
     def on_rewind(self, integ: Any) -> None:
         """A rejected interval: forget the checks after the integrator's time."""
