@@ -168,33 +168,40 @@ def test_plate_folder_has_history_and_newton_rows(tmp_path):
     _coarse_von_mises_is_written(tmp_path, SMALL_PLATE["steps"])  # first yield: no frame
 
 
+class _Interrupted(Exception):
+    pass
+
+
+def _interrupted_run(run, config, out, monkeypatch, calls: int) -> None:
+    """``run(config, out=out)`` stopped at its ``calls``-th solver step (after ``calls - 1``
+    converged steps: their checkpoint on disk), as a hard stop would."""
+    import arlequin.solvers.statics.quasi_static as qs
+
+    original, seen = qs.QuasiStaticSolver.step, []
+
+    def step(self):
+        seen.append(1)
+        if len(seen) == calls:
+            raise _Interrupted
+        return original(self)
+
+    with monkeypatch.context() as patched:
+        patched.setattr(qs.QuasiStaticSolver, "step", step)
+        with pytest.raises(_Interrupted):
+            run(config, out=str(out))
+
+
 def test_a_resumed_run_writes_the_same_files(tmp_path, monkeypatch):
     """A pressure vessel interrupted after its 6th converged step and resumed: history.csv and
     newton.csv byte for byte those of the uninterrupted run (the pattern of
     tests/test_pressure_vessel.py's resume test)."""
-    import arlequin.solvers.statics.quasi_static as qs
     from arlequin.demos.pressure_vessel import PressureVesselConfig
     from arlequin.demos.pressure_vessel import run as run_module
 
     config = PressureVesselConfig(steps=10, **COARSE)
     full, cut = tmp_path / "full", tmp_path / "cut"
     run_module.run(config, out=str(full))
-
-    class Interrupted(Exception):
-        pass
-
-    original, calls = qs.QuasiStaticSolver.step, []
-
-    def step(self):
-        calls.append(1)
-        if len(calls) == 7:
-            raise Interrupted
-        return original(self)
-
-    monkeypatch.setattr(qs.QuasiStaticSolver, "step", step)
-    with pytest.raises(Interrupted):
-        run_module.run(config, out=str(cut))
-    monkeypatch.setattr(qs.QuasiStaticSolver, "step", original)
+    _interrupted_run(run_module.run, config, cut, monkeypatch, calls=7)
     run_module.resume(str(cut))
     for name in ("history.csv", "newton.csv"):
         assert (cut / name).read_bytes() == (full / name).read_bytes(), name
@@ -204,12 +211,12 @@ def test_a_resumed_run_keeps_its_band_watch(tmp_path, monkeypatch):
     """The gluing band's watch is in the checkpoint: a sphere whose patch ends at 0.15 m (its
     band 0.125-0.15 m) yields in the band from the 8th step (240 MPa; Hill's front reaches
     0.125 m at 228 MPa); interrupted after the 9th and resumed, it reports the whole run's
-    band share and does not warn again."""
+    band share and does not warn again (without the watch in the checkpoint it warned again
+    at λ = 0.9)."""
     import json
     import warnings
 
     import arlequin
-    import arlequin.solvers.statics.quasi_static as qs
     from arlequin.demos.pressure_vessel import PressureVesselConfig
     from arlequin.demos.pressure_vessel import run as run_module
 
@@ -217,22 +224,8 @@ def test_a_resumed_run_keeps_its_band_watch(tmp_path, monkeypatch):
     full, cut = tmp_path / "full", tmp_path / "cut"
     with pytest.warns(arlequin.BandYieldWarning, match="at λ = 0.8 patch0"):
         run_module.run(config, out=str(full))
-
-    class Interrupted(Exception):
-        pass
-
-    original, calls = qs.QuasiStaticSolver.step, []
-
-    def step(self):
-        calls.append(1)
-        if len(calls) == 10:
-            raise Interrupted
-        return original(self)
-
-    monkeypatch.setattr(qs.QuasiStaticSolver, "step", step)
-    with pytest.raises(Interrupted), pytest.warns(arlequin.BandYieldWarning):
-        run_module.run(config, out=str(cut))
-    monkeypatch.setattr(qs.QuasiStaticSolver, "step", original)
+    with pytest.warns(arlequin.BandYieldWarning):
+        _interrupted_run(run_module.run, config, cut, monkeypatch, calls=10)
     with warnings.catch_warnings():
         warnings.simplefilter("error", arlequin.BandYieldWarning)
         run_module.resume(str(cut))
