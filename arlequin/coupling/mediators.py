@@ -13,7 +13,8 @@ constant λ has zero strain). Both matrices
 are computed from one Gram matrix G on the gluing cells of the integration mesh I (see
 :mod:`arlequin.coupling.overlap`): C_model = Zᵀ G P_model, with P_model the (vector) transfer to I
 and Z the mediator functions written on I. One shared quadrature makes the two transfers exact
-adjoints. The mediator space is the coarse space restricted to S_g (default) or the fine one.
+adjoints. The mediator space is the coarse space restricted to S_g or the fine one (a patch's
+``mediator="auto"`` chooses: :func:`arlequin.coupling.patches.resolve_mediator`).
 """
 
 from __future__ import annotations
