@@ -47,7 +47,7 @@ def _normal_tensor(normal, e, q, dim, nt):
     return normal[2, e, q]
 
 
-@nb.njit(parallel=True, cache=True)
+@nb.njit(parallel=True, cache=True, fastmath={"contract", "reassoc"})
 def small_strain_tangent_kernel(
     data, cells, base, row_stride, order, colour_ptr, grad, val, rinv, axi, g2, tt, cw, normal,
     bbar, dv, kv,
@@ -100,14 +100,17 @@ def small_strain_tangent_kernel(
                         s = 0.0
                         for m in range(dim):
                             s += g[a, m] * g[b, m]
+                        if axi:  # the hoop strains' product in the (a0, b0) entry
+                            hh = 2.0 * half * h[a] * h[b]
+                            loc[dim * a, dim * b] += hh
+                            if b != a:
+                                loc[dim * b, dim * a] += hh
                         for i in range(dim):
                             for j in range(dim):
                                 v = (half * g[a, j] * g[b, i] + t * tr[a, i] * tr[b, j]
                                      + c * ng[a, i] * ng[b, j])  # fmt: skip
                                 if i == j:
                                     v += half * s
-                                if i == 0 and j == 0:
-                                    v += 2.0 * half * h[a] * h[b]
                                 loc[dim * a + i, dim * b + j] += v
                                 if b != a:
                                     loc[dim * b + j, dim * a + i] += v
