@@ -211,6 +211,7 @@ KERNELS = {
     "arlequin.models.plasticity.j2_kernel_3d.solid_j2_kernel",
     "arlequin.models.plasticity.j2_tangent_kernel.j2_tangent_kernel",
     "arlequin.models.plasticity.j2_tangent_kernel._point_modulus",
+    "arlequin.models.plasticity.small_strain_kernel.small_strain_tangent_kernel",
 }
 
 

@@ -41,9 +41,11 @@ from skfem import Basis, Mesh
 
 from arlequin.contract import CellStates, StateError
 
+from ..assembly import CellPattern
 from ..elastic import LinearElastic, WeightLike
 from .hardening import Hardening
 from .j2 import J2Material
+from .small_strain_kernel import small_strain_tangent_kernel
 
 __all__ = [
     "SMALL_STRAIN_KINDS",
@@ -346,7 +348,7 @@ class SmallStrainJ2(CellStates):
         self._dv = np.asarray(basis.dx) * (2.0 * np.pi * x[0] if kind == "axisymmetric" else 1.0)
         # local dof m = dim * a + i of cell e: global dim * node + i
         self._cell_dofs = (self.dim * t.T[:, :, None] + np.arange(self.dim)).reshape(t.shape[1], -1)
-        self._pattern: tuple[np.ndarray, np.ndarray] | None = None
+        self._pattern: CellPattern | None = None  # computed at the first tangent
         self.bbar = bool(bbar)
         if self.bbar:  # div N_a e_i at the points and its cell mean (mean dilatation)
             div = self._grad.copy()
@@ -511,57 +513,20 @@ class SmallStrainJ2(CellStates):
         return self._force(ret.stress, w), self._assemble_tangent(ret, w), self._trial_state(
             ret, state)  # fmt: skip
 
-    def _bmatrix(self, cells: slice) -> np.ndarray:
-        """B matrices (Mandel strain of each cell dof), shape (n_cells, n_qp, ns, dim · nen)."""
-        g = np.moveaxis(self._grad[:, :, cells], (0, 1), (2, 3))  # (ne, nq, nen, dim)
-        ne, nq, nen, d = g.shape
-        b = np.zeros((ne, nq, self.ns, nen, d))
-        for i in range(d):
-            b[:, :, i, :, i] = g[..., i]
-        if d == 3:
-            for k, (i, j) in enumerate(_SHEARS[6]):
-                b[:, :, 3 + k, :, i] = g[..., j] / _R2
-                b[:, :, 3 + k, :, j] = g[..., i] / _R2
-        else:
-            b[:, :, 3, :, 0], b[:, :, 3, :, 1] = g[..., 1] / _R2, g[..., 0] / _R2
-            if self._rinv is not None:
-                val = np.moveaxis(self._val[:, cells], 0, -1)  # (ne, nq, nen)
-                b[:, :, 2, :, 0] = val * self._rinv[cells, :, None]
-        b = b.reshape(ne, nq, self.ns, nen * d)
-        if self.bbar:
-            div = b[:, :, 0] + b[:, :, 1] + b[:, :, 2]  # (ne, nq, nd)
-            dv = self._dv[cells]
-            mean = np.einsum("eqm,eq->em", div, dv) / dv.sum(axis=1)[:, None]
-            b[:, :, :3] += ((mean[:, None] - div) / 3.0)[:, :, None]
-        return b
-
     def _assemble_tangent(self, ret: ReturnResult, w: np.ndarray) -> sp.csr_matrix:
-        """Σ_qp w Bᵀ D B with D = K 1⊗1 + 2G(1 − a) I_dev + c n⊗n, by blocks of cells."""
-        K, G = self.material.bulk_modulus, self.material.shear_modulus
-        ne, nq = self.shape
-        nd = self._cell_dofs.shape[1]
-        g2 = 2.0 * G * (1.0 - ret.reduction) * w  # (ne, nq)
-        vol = K * w - g2 / 3.0
-        cw = ret.normal_coefficient * w
-        normal = np.moveaxis(ret.normal, 0, -1)  # (ne, nq, ns)
-        data = np.empty((ne, nd, nd))
-        block = max(1, int(4e6 // (nq * self.ns * nd)))
-        for start in range(0, ne, block):
-            c = slice(start, min(ne, start + block))
-            b = self._bmatrix(c)
-            tr = b[:, :, 0] + b[:, :, 1] + b[:, :, 2]  # (n, nq, nd)
-            nb = np.einsum("eqs,eqsm->eqm", normal[c], b)
-            bw = (b * g2[c, :, None, None]).reshape(b.shape[0], -1, nd)
-            k = np.matmul(np.swapaxes(bw, 1, 2), b.reshape(b.shape[0], -1, nd))
-            k += np.matmul(np.swapaxes(tr * vol[c, :, None], 1, 2), tr)
-            k += np.matmul(np.swapaxes(nb * cw[c, :, None], 1, 2), nb)
-            data[c] = k
+        """Σ_qp w B̄ᵀ D B̄ compiled into the CSR pattern computed at the first call."""
         if self._pattern is None:
-            rows = np.repeat(self._cell_dofs, nd, axis=1).ravel()
-            cols = np.tile(self._cell_dofs, (1, nd)).ravel()
-            self._pattern = (rows, cols)
-        rows, cols = self._pattern
-        return sp.csr_matrix((data.ravel(), (rows, cols)), shape=(self.n_dofs, self.n_dofs))
+            self._pattern = CellPattern(self.mesh.t.T, self.dim, self.mesh.p.shape[1])
+        pat, K = self._pattern, self.material.bulk_modulus
+        g2 = 2.0 * self.material.shear_modulus * (1.0 - ret.reduction) * w
+        tt = (0.0 if self.bbar else K * w) - g2 / 3.0
+        rinv = self._rinv if self._rinv is not None else np.zeros((1, 1))
+        data = small_strain_tangent_kernel(
+            np.zeros(pat.nnz), pat.cells, pat.base, pat.row_stride, pat.order, pat.colour_ptr,
+            self._grad, self._val, rinv, self._rinv is not None, g2, tt,
+            ret.normal_coefficient * w, ret.normal, self.bbar, self._dv, K * w.sum(axis=1),
+        )  # fmt: skip
+        return pat.matrix(data)
 
     # ------------------------------------------------------------------ post-processing
     def von_mises(self, state: SmallStrainState) -> np.ndarray:
