@@ -4,7 +4,7 @@ smoothed-aggregation multigrid (``solve_static(..., linear_solver="amg")``, issu
 3D linear elasticity on the quarter plate with a hole of ``tests/data/plate3d_fine.vtu``
 (tetrahedra, 50 mm × 50 mm × 5 mm, hole radius 10 mm), refined ``--levels`` times by
 ``read_mesh(...).refined(k)``, clamped at x = 0 and pulled by 100 MPa at x = W = 0.05 m; with
-``--arlequin`` also the coarse plate (``plate3d_coarse.vtu``) with the ring patch
+``--cases arlequin`` the coarse plate (``plate3d_coarse.vtu``) with the ring patch
 (``plate3d_ring.vtu``, non-nested) refined the same number of times.
 
 Each (case, level, solver) runs in a fresh process so that its peak resident memory
@@ -15,6 +15,7 @@ the relative difference of the two solutions, and per case the exponents of time
 fitted over the levels (least squares in log-log).
 
     python benchmarks/scaling.py --levels 0 1 2
+    python benchmarks/scaling.py --cases arlequin --levels 0 1
 """
 
 from __future__ import annotations
@@ -101,7 +102,13 @@ def main(argv=None) -> dict:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--levels", type=int, nargs="+", default=[0, 1])
     ap.add_argument("--superlu-max-dofs", type=int, default=200_000)
-    ap.add_argument("--arlequin", action="store_true", help="also the coarse plate + ring patch")
+    ap.add_argument(
+        "--cases",
+        nargs="+",
+        default=["mono"],
+        choices=["mono", "arlequin"],
+        help="mono: the single fine plate; arlequin: the coarse plate + ring patch",
+    )
     ap.add_argument("--one", nargs=4, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.one:
@@ -110,7 +117,7 @@ def main(argv=None) -> dict:
         return {}
     report: dict = {}
     with tempfile.TemporaryDirectory() as tmp:
-        for case in ["mono"] + (["arlequin"] if args.arlequin else []):
+        for case in args.cases:
             rows = []
             for level in args.levels:
                 amg, u_amg = _spawn(case, level, "amg", Path(tmp))

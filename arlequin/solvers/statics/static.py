@@ -45,7 +45,7 @@ STATIC_LINEAR_SOLVERS = ("auto", "superlu", "amg")
 #: Unknowns (free dofs + multipliers) of a 3D saddle point above which ``"auto"`` picks the
 #: iterative solver (measured by ``benchmarks/scaling.py``, see docs/scaling.md); 1D, 2D and
 #: axisymmetric systems stay on SuperLU.
-AMG_MIN_UNKNOWNS = 60_000
+AMG_MIN_UNKNOWNS = 30_000
 
 
 class SingularSystemError(ValueError):
