@@ -95,3 +95,16 @@ def test_bad_solver_name_and_options_are_refused():
 def test_auto_keeps_the_direct_solver_on_small_systems():
     problem, _ = build_patch_test_problem(dim="3")
     assert solve_static(problem).linear_solver == "superlu"
+
+
+def test_auto_switches_above_the_thresholds_in_3d_only(monkeypatch):
+    from arlequin.solvers.statics import static
+
+    coupled = build_patch_test_problem(dim="3")[0]
+    n = solve_static(coupled).saddle_point.matrix.shape[0]
+    monkeypatch.setattr(static, "AMG_MIN_UNKNOWNS", 1)
+    assert solve_static(coupled).linear_solver == "superlu"  # multipliers: the other threshold
+    monkeypatch.setattr(static, "AMG_MIN_UNKNOWNS_COUPLED", n)
+    assert solve_static(coupled).linear_solver == "amg"
+    monkeypatch.setattr(static, "AMG_MIN_UNKNOWNS_COUPLED", 1)
+    assert solve_static(build_patch_test_problem(dim="2")[0]).linear_solver == "superlu"

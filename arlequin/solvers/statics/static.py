@@ -29,6 +29,7 @@ logger = logging.getLogger(__name__)
 
 __all__ = [
     "AMG_MIN_UNKNOWNS",
+    "AMG_MIN_UNKNOWNS_COUPLED",
     "STATIC_LINEAR_SOLVERS",
     "SaddlePoint",
     "SingularSystemError",
@@ -42,10 +43,15 @@ __all__ = [
 
 #: The ``linear_solver`` values of :func:`solve_static`.
 STATIC_LINEAR_SOLVERS = ("auto", "superlu", "amg")
-#: Unknowns (free dofs + multipliers) of a 3D saddle point above which ``"auto"`` picks the
-#: iterative solver (measured by ``benchmarks/scaling.py``, see docs/scaling.md); 1D, 2D and
-#: axisymmetric systems stay on SuperLU.
+#: Unknowns (free dofs) of a 3D system without multiplier rows (a single model) from which
+#: ``"auto"`` picks the iterative solver (measured by ``benchmarks/scaling.py``, see
+#: docs/scaling.md: the two cost the same at 15-20k); 1D, 2D and axisymmetric systems stay on
+#: SuperLU.
 AMG_MIN_UNKNOWNS = 30_000
+#: The same with multiplier rows (mediators, user rows): their augmentation γ Bᵀ W⁻¹ B holds
+#: 1.7 to 7 times the stiffness's entries, and the two solvers cost the same at about 120k to
+#: 150k unknowns on the 3D plate with a refined ring patch.
+AMG_MIN_UNKNOWNS_COUPLED = 150_000
 
 
 class SingularSystemError(ValueError):
@@ -328,7 +334,8 @@ def solve_static(
         ``"superlu"``: the sparse LU of the scaled saddle point (the reference); ``"amg"``: GMRES
         preconditioned by an augmented Lagrangian and smoothed-aggregation multigrid
         (:func:`arlequin.linalg.saddle_amg.solve_saddle_amg`); ``"auto"``: ``"amg"`` for 3D
-        systems of at least ``AMG_MIN_UNKNOWNS`` unknowns, SuperLU otherwise. Linear problems
+        systems of at least ``AMG_MIN_UNKNOWNS`` unknowns (``AMG_MIN_UNKNOWNS_COUPLED`` with
+        multiplier rows), SuperLU otherwise. Linear problems
         only (a nonlinear one is solved by the quasi-static solver's direct solvers).
     linear_solver_options : dict, optional
         For ``"amg"``: ``rtol`` (true relative residual, default 1e-10), ``maxiter`` (GMRES
@@ -408,12 +415,13 @@ def _result(system, sp_sys: SaddlePoint, x, name: str, krylov) -> StaticResult:
 
 
 def _choose_solver(name: str, system: CoupledSystem, sp_sys: SaddlePoint) -> str:
-    """``"auto"`` resolved: the iterative solver on 3D systems of ``AMG_MIN_UNKNOWNS`` unknowns
-    or more, SuperLU otherwise."""
+    """``"auto"`` resolved: the iterative solver on 3D systems of at least ``AMG_MIN_UNKNOWNS``
+    unknowns (``AMG_MIN_UNKNOWNS_COUPLED`` with multiplier rows), SuperLU otherwise."""
     if name != "auto":
         return name
     kinds = {getattr(b.model, "kind", None) for b in system.blocks}
-    big = sp_sys.matrix.shape[0] >= AMG_MIN_UNKNOWNS
+    coupled = sp_sys.matrix.shape[0] > sp_sys.n_free
+    big = sp_sys.matrix.shape[0] >= (AMG_MIN_UNKNOWNS_COUPLED if coupled else AMG_MIN_UNKNOWNS)
     return "amg" if big and kinds == {"3d"} else "superlu"
 
 
