@@ -104,6 +104,7 @@ from .contract import (
     CoarseYieldWarning,
     ConstraintError,
     ContractError,
+    LinearSolverError,
     SimulationError,
     StateError,
 )
@@ -138,6 +139,7 @@ __all__ = [
     "DofMap",
     "DynamicResult",
     "ExactnessWarning",
+    "LinearSolverError",
     "MediatorError",
     "MeshError",
     "MultiBodyProblem",

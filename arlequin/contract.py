@@ -56,35 +56,13 @@ import numpy as np
 import scipy.sparse as sp
 
 __all__ = [
-    "CAPABILITIES",
-    "BandYieldWarning",
-    "CapabilityError",
-    "CellStates",
-    "CoarseYieldWarning",
-    "ConstraintError",
-    "ConstraintState",
-    "ConstraintTrial",
-    "ContractError",
-    "DynamicModel",
-    "Model",
-    "SimulationError",
-    "StateError",
-    "SupportsCellStates",
-    "SupportsCriticalTimeStep",
-    "SupportsTangent",
-    "UnilateralConstraint",
-    "capabilities",
-    "check_protocol",
-    "csr_pattern",
-    "csr_with_data",
-    "is_linear",
-    "is_unilateral",
-    "node_dofs",
-    "put_cells",
-    "require",
-    "same_pattern",
-    "take_cells",
-]
+    "CAPABILITIES", "BandYieldWarning", "CapabilityError", "CellStates", "CoarseYieldWarning",
+    "ConstraintError", "ConstraintState", "ConstraintTrial", "ContractError", "DynamicModel",
+    "LinearSolverError", "Model", "SimulationError", "StateError", "SupportsCellStates",
+    "SupportsCriticalTimeStep", "SupportsTangent", "UnilateralConstraint", "capabilities",
+    "check_protocol", "csr_pattern", "csr_with_data", "is_linear", "is_unilateral", "node_dofs",
+    "put_cells", "require", "same_pattern", "take_cells",
+]  # fmt: skip
 
 
 # ---------------------------------------------------------------------------------------------
@@ -129,6 +107,12 @@ class BandYieldWarning(UserWarning):
 
 class ConstraintError(ValueError):
     """The constraint rows cannot be enforced (linearly dependent rows, zero masses...)."""
+
+
+class LinearSolverError(ValueError):
+    """An iterative linear solve did not reach its tolerance: its true residual (relative to the
+    right-hand side) is above it after the allowed iterations. No unconverged solution is ever
+    returned; the message names the residual reached and the iterations spent."""
 
 
 class CapabilityError(ValueError):

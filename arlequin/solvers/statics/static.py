@@ -6,7 +6,9 @@
 
 Dirichlet rows are eliminated (their dofs are removed and moved to the right-hand side); all other
 equality rows (mediator equations, user constraints) keep their Lagrange multipliers. The sparse
-system is solved by SuperLU (scipy). Units: displacements m, multipliers in the units of the
+system is solved by SuperLU (scipy) or, with ``linear_solver="amg"`` (and ``"auto"`` on large 3D
+systems), by GMRES with an augmented-Lagrangian smoothed-aggregation multigrid preconditioner
+(:mod:`arlequin.linalg.saddle_amg`). Units: displacements m, multipliers in the units of the
 constraint rows' dual (N for Dirichlet reactions).
 """
 
@@ -20,11 +22,15 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ...contract import is_linear
+from ...linalg.saddle_amg import KrylovInfo, solve_saddle_amg
 from ...problem.system import CoupledSystem
 
 logger = logging.getLogger(__name__)
 
 __all__ = [
+    "AMG_MIN_UNKNOWNS",
+    "AMG_MIN_UNKNOWNS_COUPLED",
+    "STATIC_LINEAR_SOLVERS",
     "SaddlePoint",
     "SingularSystemError",
     "StaticResult",
@@ -33,6 +39,19 @@ __all__ = [
     "rigid_modes",
     "solve_static",
 ]
+
+
+#: The ``linear_solver`` values of :func:`solve_static`.
+STATIC_LINEAR_SOLVERS = ("auto", "superlu", "amg")
+#: Unknowns (free dofs) of a 3D system without multiplier rows (a single model) from which
+#: ``"auto"`` picks the iterative solver (measured by ``benchmarks/scaling.py``, see
+#: docs/scaling.md: the two cost the same at 15-20k); 1D, 2D and axisymmetric systems stay on
+#: SuperLU.
+AMG_MIN_UNKNOWNS = 30_000
+#: The same with multiplier rows (mediators, user rows): their augmentation γ Bᵀ W⁻¹ B holds
+#: 1.7 to 7 times the stiffness's entries, and the two solvers cost the same at about 120k to
+#: 150k unknowns on the 3D plate with a refined ring patch.
+AMG_MIN_UNKNOWNS_COUPLED = 150_000
 
 
 class SingularSystemError(ValueError):
@@ -179,6 +198,10 @@ class StaticResult:
         Relative residual of the solution in the discrete equations.
     u : ndarray
         Global displacement vector (m).
+    linear_solver : str
+        The solver used: ``"superlu"`` or ``"amg"``.
+    krylov : KrylovInfo or None
+        Iterations, true residual and times (multigrid set-up, Krylov) of the iterative solve.
     """
 
     displacements: dict[str, np.ndarray]
@@ -188,6 +211,8 @@ class StaticResult:
     u: np.ndarray
     system: CoupledSystem = field(repr=False)
     saddle_point: SaddlePoint | None = field(repr=False)
+    linear_solver: str = "superlu"
+    krylov: KrylovInfo | None = None
 
 
 def rigid_modes(system: CoupledSystem) -> tuple[np.ndarray, list[str]] | None:
@@ -283,7 +308,13 @@ def _solve_saddle(mat: sp.csc_matrix, rhs: np.ndarray) -> np.ndarray:
     return spla.spsolve(mat, rhs)
 
 
-def solve_static(problem, t: float = 0.0) -> StaticResult:
+def solve_static(
+    problem,
+    t: float = 0.0,
+    *,
+    linear_solver: str = "auto",
+    linear_solver_options: dict | None = None,
+) -> StaticResult:
     """Solve the static coupled problem (an ``ArlequinProblem`` or a ``CoupledSystem``).
 
     A problem whose models are all linear is one sparse solve of the saddle point. A problem
@@ -294,17 +325,52 @@ def solve_static(problem, t: float = 0.0) -> StaticResult:
     follows a proportional path (call ``solve_quasi_static`` for another path, for the history
     of the steps, or to resume). The strain energies of its nonlinear blocks are not given.
 
+    Parameters
+    ----------
+    problem : ArlequinProblem or CoupledSystem
+    t : float
+        Time (s) of the loads and prescribed values.
+    linear_solver : {"auto", "superlu", "amg"}
+        ``"superlu"``: the sparse LU of the scaled saddle point (the reference); ``"amg"``: GMRES
+        preconditioned by an augmented Lagrangian and smoothed-aggregation multigrid
+        (:func:`arlequin.linalg.saddle_amg.solve_saddle_amg`); ``"auto"``: ``"amg"`` for 3D
+        systems of at least ``AMG_MIN_UNKNOWNS`` unknowns (``AMG_MIN_UNKNOWNS_COUPLED`` with
+        multiplier rows), SuperLU otherwise. Linear problems
+        only (a nonlinear one is solved by the quasi-static solver's direct solvers).
+    linear_solver_options : dict, optional
+        For ``"amg"``: ``rtol`` (true relative residual, default 1e-10), ``maxiter`` (GMRES
+        iterations, default 1000), ``gamma`` (the augmentation, default the mean of the
+        stiffness's diagonal).
+
     Raises
     ------
     SingularSystemError
         If the supports leave a rigid-body motion free (checked before solving), or the
         system is singular for another reason (dependent constraint rows).
+    LinearSolverError
+        If the iterative solve's true residual stays above its tolerance.
     ValueError
-        If a load is not finite.
+        If a load is not finite, or ``linear_solver`` is not one of ``STATIC_LINEAR_SOLVERS``.
     """
+    if linear_solver not in STATIC_LINEAR_SOLVERS:
+        raise ValueError(
+            f"linear_solver must be one of {STATIC_LINEAR_SOLVERS}, got {linear_solver!r}"
+        )
+    options = dict(linear_solver_options or {})
+    unknown = set(options) - {"rtol", "maxiter", "gamma"}
+    if unknown:
+        raise ValueError(
+            f"linear_solver_options: unknown option(s) {sorted(unknown)}; "
+            "known: 'rtol', 'maxiter', 'gamma'"
+        )
     system = problem if isinstance(problem, CoupledSystem) else problem.system()
     check_supports(system, t)
     if not all(is_linear(term.model) for b in system.blocks for term in b.terms):
+        if linear_solver == "amg":
+            raise ValueError(
+                "linear_solver='amg' is not available for nonlinear static problems yet: use "
+                "'auto' or 'superlu'"
+            )
         return _solve_nonlinear(system, t)
     sp_sys = assemble_saddle_point(system, t)
     bad = np.nonzero(~np.isfinite(sp_sys.load))[0]
@@ -313,6 +379,11 @@ def solve_static(problem, t: float = 0.0) -> StaticResult:
             f"the load vector has {bad.size} non-finite value(s) (first at global dof "
             f"{int(bad[0])}): check the body forces and tractions"
         )
+    name = _choose_solver(linear_solver, system, sp_sys)
+    krylov = None
+    if name == "amg":
+        x, krylov = _solve_amg(system, sp_sys, options)
+        return _result(system, sp_sys, x, name, krylov)
     try:
         x = _solve_saddle(sp_sys.matrix, sp_sys.rhs)
     except RuntimeError as exc:  # SuperLU: "Factor is exactly singular"
@@ -322,6 +393,11 @@ def solve_static(problem, t: float = 0.0) -> StaticResult:
             "the coupled static system is singular (non-finite solution): check that the coarse "
             "model's rigid motions are removed and that the mediator rows are independent"
         )
+    return _result(system, sp_sys, x, name, krylov)
+
+
+def _result(system, sp_sys: SaddlePoint, x, name: str, krylov) -> StaticResult:
+    """The static result of the saddle point's solution x (scaled multipliers)."""
     u = sp_sys.full_displacement(x[: sp_sys.n_free])
     lam = x[sp_sys.n_free :] * sp_sys.constraint_scale
     residual = sp_sys.residual(u, lam)
@@ -333,6 +409,48 @@ def solve_static(problem, t: float = 0.0) -> StaticResult:
         u=u,
         system=system,
         saddle_point=sp_sys,
+        linear_solver=name,
+        krylov=krylov,
+    )
+
+
+def _choose_solver(name: str, system: CoupledSystem, sp_sys: SaddlePoint) -> str:
+    """``"auto"`` resolved: the iterative solver on 3D systems of at least ``AMG_MIN_UNKNOWNS``
+    unknowns (``AMG_MIN_UNKNOWNS_COUPLED`` with multiplier rows), SuperLU otherwise."""
+    if name != "auto":
+        return name
+    kinds = {getattr(b.model, "kind", None) for b in system.blocks}
+    coupled = sp_sys.matrix.shape[0] > sp_sys.n_free
+    big = sp_sys.matrix.shape[0] >= (AMG_MIN_UNKNOWNS_COUPLED if coupled else AMG_MIN_UNKNOWNS)
+    return "amg" if big and kinds == {"3d"} else "superlu"
+
+
+def _solve_amg(system: CoupledSystem, sp_sys: SaddlePoint, options: dict):
+    """The saddle point by GMRES + augmented-Lagrangian multigrid, the rigid-body modes of each
+    block (zero on the other blocks) as near-null space, multigrid on the full numbering."""
+    n = sp_sys.free.size + sp_sys.fixed.size
+    modes = rigid_modes(system)
+    near_null, blocksize = None, 1
+    if modes is not None:
+        r = modes[0]
+        k = r.shape[1]
+        near_null = np.zeros((n, k * len(system.blocks)))
+        for i, b in enumerate(system.blocks):
+            near_null[b.dofs, i * k : (i + 1) * k] = r[b.dofs]
+        dims = {int(np.asarray(b.model.mesh.p).shape[0]) for b in system.blocks}
+        d = dims.pop() if len(dims) == 1 else 1
+        if all(b.offset % d == 0 and b.n_dofs % d == 0 for b in system.blocks):
+            blocksize = d
+    nf = sp_sys.n_free
+    return solve_saddle_amg(
+        sp_sys.matrix[:nf, :nf],
+        sp_sys.matrix[nf:, :nf],
+        sp_sys.rhs,
+        near_null_space=near_null,
+        free=sp_sys.free,
+        n_full=n,
+        blocksize=blocksize,
+        **options,
     )
 
 
