@@ -94,7 +94,7 @@ _BANDS: weakref.WeakKeyDictionary[Any, tuple[np.ndarray, np.ndarray]] = weakref.
 def band_cells(pc: PatchCoupling) -> np.ndarray:
     """The patch cells of the gluing band, shape (n_fine_elems,) bool."""
     mask = np.zeros(pc.fine_model.mesh.nelements, dtype=bool)
-    mask[pc.overlap.fine_cells[pc.gluing_cells]] = True
+    mask[pc.fine_gluing_cells] = True
     return mask
 
 
@@ -167,5 +167,4 @@ def plastic_peak(model: Any, state: Any, band: np.ndarray | None = None) -> Plas
 def largest_plastic_strain(pc: PatchCoupling, state: Any) -> PlasticPeak | None:
     """The largest equivalent plastic strain of the patch of ``pc`` and whether it lies in the
     gluing band (None for a patch model without plastic strain)."""
-    return plastic_peak(pc.fine_model, state, _band(pc, pc.fine_model.scalar_basis)[0]
-                        if _measures(pc.fine_model) else None)  # fmt: skip
+    return plastic_peak(pc.fine_model, state, band_cells(pc))

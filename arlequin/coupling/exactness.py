@@ -33,6 +33,7 @@ class GluedPatch(Protocol):
     fine_model: Any
     weights: Any
     gluing_cells: np.ndarray
+    fine_gluing_cells: np.ndarray
 
     def _fine_nodal(self, which: str) -> np.ndarray: ...
 
@@ -71,11 +72,9 @@ def unheld_band_cells(pc: GluedPatch) -> np.ndarray:
     """
     if pc.weights.mode != "nodal":
         return np.zeros(0, dtype=np.int64)
-    fmesh = pc.fine_model.mesh
-    band = np.zeros(fmesh.nelements, dtype=bool)
-    band[pc.overlap.fine_cells[pc.gluing_cells]] = True
-    held = np.any(pc._fine_nodal("fine")[fmesh.t] > 0.0, axis=0)
-    return np.nonzero(band & ~held)[0]
+    band = np.asarray(pc.fine_gluing_cells)
+    held = np.any(pc._fine_nodal("fine")[pc.fine_model.mesh.t[:, band]] > 0.0, axis=0)
+    return band[~held]
 
 
 def _unheld_cells(pc: GluedPatch) -> list[str]:
